@@ -1,0 +1,243 @@
+"""Typed configuration: dataclasses validated at the edge, loaded from TOML, overridden by ``a.b=v``.
+
+A config class is a dataclass whose fields may carry bounds with :func:`field`::
+
+    @dataclass
+    class Train:
+        rounds: int = field(500, ge=1)
+        mode: str = field("fast", choices=("fast", "exact"))
+
+:func:`from_dict` builds one from plain data and raises :class:`ConfigError` with a one-line message
+naming the key, the value and what is allowed; :func:`to_dict` turns it back into TOML-ready data.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+import types
+import typing
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, TypeVar
+
+T = TypeVar("T")
+
+
+class ConfigError(ValueError):
+    """A user's config is wrong; the message is one line, fit to print without a traceback."""
+
+
+def field(
+    default: Any = dataclasses.MISSING,
+    *,
+    ge: float | None = None,
+    gt: float | None = None,
+    le: float | None = None,
+    lt: float | None = None,
+    choices: Sequence[Any] | None = None,
+    default_factory: Any = dataclasses.MISSING,
+    doc: str = "",
+) -> Any:
+    """A dataclass field with bounds (``ge``/``gt``/``le``/``lt``) or allowed ``choices``, checked on load."""
+    meta = {"ge": ge, "gt": gt, "le": le, "lt": lt, "choices": tuple(choices) if choices else None, "doc": doc}
+    if default_factory is not dataclasses.MISSING:
+        return dataclasses.field(default_factory=default_factory, metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+def _allowed(meta: Mapping[str, Any]) -> str:
+    if meta.get("choices"):
+        return "one of " + ", ".join(repr(c) for c in meta["choices"])
+    parts = []
+    for key, sym in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
+        if meta.get(key) is not None:
+            parts.append(f"{sym} {meta[key]}")
+    return " and ".join(parts)
+
+
+def _check_bounds(key: str, value: Any, meta: Mapping[str, Any]) -> None:
+    choices = meta.get("choices")
+    if choices and value not in choices:
+        raise ConfigError(f"{key} = {value!r} is not allowed: use {_allowed(meta)}")
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        bad = (
+            (meta.get("ge") is not None and not value >= meta["ge"])
+            or (meta.get("gt") is not None and not value > meta["gt"])
+            or (meta.get("le") is not None and not value <= meta["le"])
+            or (meta.get("lt") is not None and not value < meta["lt"])
+            or (isinstance(value, float) and math.isnan(value))
+        )
+        if bad:
+            raise ConfigError(f"{key} = {value!r} is out of range: must be {_allowed(meta)}")
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__name__", str(tp)).replace("typing.", "")
+
+
+def _coerce(key: str, value: Any, tp: Any) -> Any:
+    """Check ``value`` against the annotation ``tp`` and convert what is safe (int -> float, list -> tuple)."""
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if tp is Any:
+        return value
+    if origin in (typing.Union, types.UnionType):
+        if value is None and type(None) in args:
+            return None
+        errors = []
+        for arg in (a for a in args if a is not type(None)):
+            try:
+                return _coerce(key, value, arg)
+            except ConfigError as exc:
+                errors.append(str(exc))
+        allowed = " or ".join(_type_name(a) for a in args)
+        raise ConfigError(f"{key} = {value!r} has the wrong type: expected {allowed}")
+    if origin is typing.Literal:
+        if value not in args:
+            raise ConfigError(f"{key} = {value!r} is not allowed: use one of {', '.join(map(repr, args))}")
+        return value
+    if origin in (tuple, list, Sequence) or tp in (tuple, list):
+        if isinstance(value, str) or not isinstance(value, Sequence):
+            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a list")
+        if args and origin is tuple and len(args) == 2 and args[1] is Ellipsis:
+            items = [_coerce(f"{key}[{i}]", v, args[0]) for i, v in enumerate(value)]
+        elif args and origin is tuple:
+            if len(args) != len(value):
+                raise ConfigError(f"{key} = {value!r} must have {len(args)} items")
+            items = [_coerce(f"{key}[{i}]", v, a) for i, (v, a) in enumerate(zip(value, args, strict=True))]
+        elif args:
+            items = [_coerce(f"{key}[{i}]", v, args[0]) for i, v in enumerate(value)]
+        else:
+            items = list(value)
+        return tuple(items) if origin is tuple or tp is tuple else items
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a table of {_type_name(tp)} keys")
+        return from_dict(tp, value, prefix=key)
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a number")
+        return float(value)
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{key} = {value!r} has the wrong type: expected an integer")
+        return value
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{key} = {value!r} has the wrong type: expected true or false")
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a string")
+        return value
+    if isinstance(tp, type) and not isinstance(value, tp):
+        raise ConfigError(f"{key} = {value!r} has the wrong type: expected {_type_name(tp)}")
+    return value
+
+
+def from_dict(cls: type[T], data: Mapping[str, Any], prefix: str = "") -> T:
+    """Build the dataclass ``cls`` from plain data, validating every key, type and range."""
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+    kwargs: dict[str, Any] = {}
+    for key, value in data.items():
+        full = f"{prefix}.{key}" if prefix else key
+        if key not in fields:
+            raise ConfigError(f"unknown key {full!r}: allowed keys here are {', '.join(sorted(fields))}")
+        value = _coerce(full, value, hints[key])
+        _check_bounds(full, value, fields[key].metadata)
+        kwargs[key] = value
+    try:
+        return cls(**kwargs)
+    except ConfigError:
+        raise
+    except (ValueError, TypeError) as exc:  # a class's own __post_init__ check
+        where = f" in {prefix}" if prefix else ""
+        raise ConfigError(f"{str(exc).splitlines()[0]}{where}") from None
+
+
+def to_dict(obj: Any) -> dict[str, Any]:
+    """A config dataclass as plain TOML-ready data (tuples become lists, ``None`` values are dropped)."""
+
+    def plain(v: Any) -> Any:
+        if dataclasses.is_dataclass(v) and not isinstance(v, type):
+            return {f.name: plain(getattr(v, f.name)) for f in dataclasses.fields(v) if getattr(v, f.name) is not None}
+        if isinstance(v, tuple | list):
+            return [plain(x) for x in v]
+        if isinstance(v, Mapping):
+            return {k: plain(x) for k, x in v.items()}
+        return v
+
+    return plain(obj)
+
+
+def merge(base: Mapping[str, Any], update: Mapping[str, Any]) -> dict[str, Any]:
+    """Deep-merge two plain config tables (``update`` wins)."""
+    out = dict(base)
+    for k, v in update.items():
+        out[k] = merge(out[k], v) if isinstance(v, Mapping) and isinstance(out.get(k), Mapping) else v
+    return out
+
+
+def parse_override(text: str) -> dict[str, Any]:
+    """``"learner.alpha=0.2"`` -> ``{"learner": {"alpha": 0.2}}``; the value is read as TOML, else as a string."""
+    if "=" not in text:
+        raise ConfigError(f"--set {text!r} must look like key.path=value")
+    key, raw = (s.strip() for s in text.split("=", 1))
+    if not key or any(not part for part in key.split(".")):
+        raise ConfigError(f"--set {text!r} has an empty key")
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    out: dict[str, Any] = {}
+    node = out
+    parts = key.split(".")
+    for part in parts[:-1]:
+        node = node.setdefault(part, {})
+    node[parts[-1]] = value
+    return out
+
+
+def load_toml(path: str | Path) -> dict[str, Any]:
+    """Read a TOML file; a missing or malformed file is a ConfigError."""
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise ConfigError(f"config file {str(p)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"config file {str(p)!r} is not valid TOML: {exc}") from None
+
+
+def to_toml(data: Mapping[str, Any]) -> str:
+    """Write plain config data as TOML (tables after scalar keys)."""
+    lines: list[str] = []
+
+    def scalar(v: Any) -> str:
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, str):
+            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        if isinstance(v, float):
+            return repr(v) if math.isfinite(v) else ("inf" if v > 0 else "-inf" if v < 0 else "nan")
+        if isinstance(v, list | tuple):
+            return "[" + ", ".join(scalar(x) for x in v) + "]"
+        if isinstance(v, Mapping):
+            return "{ " + ", ".join(f"{k} = {scalar(x)}" for k, x in v.items()) + " }"
+        return str(v)
+
+    def table(name: str, node: Mapping[str, Any]) -> None:
+        plain = {k: v for k, v in node.items() if not isinstance(v, Mapping)}
+        subs = {k: v for k, v in node.items() if isinstance(v, Mapping)}
+        if name and (plain or not subs):
+            lines.append(f"\n[{name}]")
+        lines.extend(f"{k} = {scalar(v)}" for k, v in plain.items())
+        for k, v in subs.items():
+            table(f"{name}.{k}" if name else k, v)
+
+    table("", data)
+    return "\n".join(lines).lstrip("\n") + "\n"

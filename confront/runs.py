@@ -1,0 +1,131 @@
+"""Run folders: where every training run writes what it did.
+
+    <run>/config.toml          the fully resolved config (re-runnable with ``confront train -c``)
+    <run>/metrics/rounds.csv   one row per round (and .parquet when pyarrow is installed)
+    <run>/metrics/sessions.csv one row per session of rounds
+    <run>/plots/*.png          figures
+    <run>/checkpoints/         data-only checkpoints (see confront.checkpoint)
+    <run>/replays/             optional battle replays
+    <run>/summary.json         headline numbers, wall time, versions
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from confront.checkpoint import write_atomic
+from confront.config import to_toml
+
+try:  # Parquet is written when pyarrow is present (extra `confront[parquet]`); CSV always.
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+except ImportError:  # pragma: no cover - exercised on installs without the extra
+    pa = None
+    pq = None
+
+SUBDIRS = ("metrics", "plots", "checkpoints", "replays")
+
+
+def new_run_name(prefix: str) -> str:
+    """A sortable, unique-enough run name: ``<prefix>-YYYYmmdd-HHMMSS``."""
+    return f"{prefix}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def _json_default(v: Any) -> Any:
+    if hasattr(v, "item"):
+        return v.item()
+    if hasattr(v, "tolist"):
+        return v.tolist()
+    raise TypeError(f"cannot write {type(v).__name__} as JSON")
+
+
+def _clean(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+@dataclass(frozen=True)
+class Run:
+    """A run folder."""
+
+    path: Path
+
+    @classmethod
+    def create(cls, path: str | Path, config: Mapping[str, Any] | None = None, exist_ok: bool = False) -> Run:
+        """Make the folder (and its sub-folders); write the resolved config if given."""
+        p = Path(path)
+        if p.exists() and any(p.iterdir()) and not exist_ok:
+            raise FileExistsError(f"run folder {p} already exists; pick another --out or use --resume")
+        for sub in SUBDIRS:
+            (p / sub).mkdir(parents=True, exist_ok=True)
+        run = cls(p)
+        if config is not None:
+            write_atomic(p / "config.toml", to_toml(config).encode())
+        return run
+
+    @property
+    def checkpoints(self) -> Path:
+        return self.path / "checkpoints"
+
+    @property
+    def plots(self) -> Path:
+        return self.path / "plots"
+
+    @property
+    def replays(self) -> Path:
+        return self.path / "replays"
+
+    def write_table(self, name: str, rows: Sequence[Mapping[str, Any]]) -> list[Path]:
+        """Write ``metrics/<name>.csv`` (and ``.parquet``) atomically from a list of flat dict rows."""
+        out = self.path / "metrics"
+        out.mkdir(parents=True, exist_ok=True)
+        columns: list[str] = []
+        for row in rows:
+            columns.extend(k for k in row if k not in columns)
+        buf = io.StringIO()
+        writer = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: _clean(row.get(k)) for k in columns})
+        written = [out / f"{name}.csv"]
+        write_atomic(written[0], buf.getvalue().encode())
+        if pa is not None and rows:
+            table = pa.table({c: [_clean(r.get(c)) for r in rows] for c in columns})
+            sink = pa.BufferOutputStream()
+            pq.write_table(table, sink)
+            written.append(out / f"{name}.parquet")
+            write_atomic(written[1], sink.getvalue().to_pybytes())
+        return written
+
+    def read_table(self, name: str) -> list[dict[str, Any]]:
+        """Read ``metrics/<name>.csv`` back as rows of floats (ints where integral) and strings."""
+
+        def parse(v: str) -> Any:
+            if v == "":
+                return None
+            try:
+                f = float(v)
+            except ValueError:
+                return v
+            return int(f) if f.is_integer() and "." not in v and "e" not in v.lower() else f
+
+        with (self.path / "metrics" / f"{name}.csv").open() as fh:
+            return [{k: parse(v) for k, v in row.items()} for row in csv.DictReader(fh)]
+
+    def write_json(self, name: str, data: Mapping[str, Any]) -> Path:
+        """Write ``<run>/<name>`` as JSON atomically."""
+        path = self.path / name
+        write_atomic(path, json.dumps(data, indent=2, default=_json_default, sort_keys=True).encode())
+        return path
+
+    def write_summary(self, data: Mapping[str, Any]) -> Path:
+        return self.write_json("summary.json", data)

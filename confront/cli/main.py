@@ -1,0 +1,221 @@
+"""The ``confront`` command. Each subcommand is a thin layer over a function of the package."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from confront.checkpoint import CheckpointError
+from confront.config import ConfigError
+
+USER_ERRORS: tuple[type[BaseException], ...] = (ConfigError, CheckpointError, FileExistsError, FileNotFoundError)
+
+
+class Group(click.Group):
+    """A click group that turns user mistakes into one line on stderr and exit code 2."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except USER_ERRORS as exc:
+            click.echo(f"error: {exc}", err=True)
+            sys.exit(2)
+        except _engine_errors() as exc:
+            click.echo(f"error: {exc}", err=True)
+            sys.exit(2)
+
+
+def _engine_errors() -> tuple[type[BaseException], ...]:
+    try:
+        from confront.engine import EngineError  # type: ignore[attr-defined]
+    except ImportError:
+        return ()
+    return (EngineError,)
+
+
+def set_option(f: Callable[..., Any]) -> Callable[..., Any]:
+    return click.option(
+        "--set", "overrides", multiple=True, metavar="KEY=VALUE",
+        help="Override a config key, e.g. --set learner.alpha=0.2 (repeatable).",
+    )(f)
+
+
+@click.group(cls=Group, context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(package_name="confront")
+def cli() -> None:
+    """confront: fuzzy RL and curriculum transfer for teams of Robocode tanks."""
+
+
+@cli.command()
+@click.option("--out", type=click.Path(path_type=Path), default=None, help="Run folder (default runs/demo-<time>).")
+@click.option("--rounds", type=int, default=None, help="Rounds to train (default from the demo config).")
+@click.option("--seed", type=int, default=None)
+@set_option
+def demo(out: Path | None, rounds: int | None, seed: int | None, overrides: tuple[str, ...]) -> None:
+    """Train a small 4v4 fuzzy DMNN team against the TD team, then print and plot the results."""
+    from confront.experiments.demo import run_demo
+
+    run_demo(out=out, rounds=rounds, seed=seed, overrides=overrides)
+
+
+@cli.command()
+@click.option("-c", "--config", "config", default="demo", show_default=True,
+              help="Experiment name (see `confront config list`) or a TOML file.")
+@click.option("--out", type=click.Path(path_type=Path), default=None, help="Run folder to create.")
+@click.option("--resume", type=click.Path(path_type=Path, exists=True, file_okay=False), default=None,
+              help="Continue the run in this folder from its latest checkpoint.")
+@click.option("--seed", type=int, default=None)
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+@set_option
+def train(config: str, out: Path | None, resume: Path | None, seed: int | None, quiet: bool,
+          overrides: tuple[str, ...]) -> None:
+    """Train one arm of an experiment in the simulator (resumable with --resume)."""
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import print_summary, train_run
+
+    if resume is not None:
+        summary = train_run(None, resume, resume=True, progress=not quiet)
+    else:
+        extra = (f"train.seed={seed}",) if seed is not None else ()
+        cfg = load_experiment(config, overrides + extra)
+        summary = train_run(cfg, out, progress=not quiet)
+    print_summary(summary)
+
+
+@cli.command()
+@click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
+@click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
+@click.option("--opponents", default=None, help="Comma list of opponents (default: the run's).")
+@click.option("--rounds", type=int, default=100, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True)
+def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: int) -> None:
+    """Play a trained policy greedily (simulator or real engine) and print its score table."""
+    from confront.experiments.evaluate import evaluate_cli
+
+    evaluate_cli(run, engine=engine, opponents=opponents, rounds=rounds, seed=seed)
+
+
+@cli.command()
+@click.argument("experiment", type=click.Choice(["migration", "awm", "fuzzy", "transfer", "baselines", "all"]))
+@click.option("--seeds", type=int, default=None, help="Seeds per arm (default 10; migration 30).")
+@click.option("--rounds", type=int, default=None, help="Rounds per arm (default from the config).")
+@click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
+@click.option("--out", type=click.Path(path_type=Path), default=None, help="Output folder (default results/).")
+@click.option("--workers", type=int, default=None, help="Parallel worker processes (default: all cores).")
+@set_option
+def reproduce(experiment: str, seeds: int | None, rounds: int | None, engine: str, out: Path | None,
+              workers: int | None, overrides: tuple[str, ...]) -> None:
+    """Re-run an experiment of the paper over seeds: metrics, figures with bands and report.md."""
+    from confront.experiments.reproduce import reproduce_cli
+
+    reproduce_cli(experiment, seeds=seeds, rounds=rounds, engine=engine, out=out, workers=workers,
+                  overrides=overrides)
+
+
+@cli.command()
+@click.argument("grid", type=click.Path(path_type=Path, exists=True, dir_okay=False))
+@click.option("--out", type=click.Path(path_type=Path), required=True, help="Sweep folder (resumable).")
+@click.option("--address", default=None, help="Ray cluster address (default: start Ray locally).")
+@click.option("--seeds", type=int, default=None, help="Seeds per config (overrides the grid file).")
+def sweep(grid: Path, out: Path, address: str | None, seeds: int | None) -> None:
+    """Run a grid of configs x seeds on Ray; re-running resumes and skips finished trials."""
+    from confront.experiments.sweep import sweep_cli
+
+    sweep_cli(grid, out=out, address=address, seeds=seeds)
+
+
+@cli.command()
+@click.option("--scenario", default="1v1", show_default=True)
+@click.option("--robots", default=None, help="Comma list of robots/teams (default: the scenario's).")
+@click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
+@click.option("--rounds", type=int, default=10, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--replay", "replay_out", type=click.Path(path_type=Path), default=None,
+              help="Also record the first round to this replay file (.json; simulator only).")
+def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: int, replay_out: Path | None) -> None:
+    """Run a battle of scripted robots in the simulator or the real engine and print Robocode's score table."""
+    from confront.experiments.evaluate import battle_cli
+
+    battle_cli(scenario=scenario, robots=robots, engine=engine, rounds=rounds, seed=seed, replay_out=replay_out)
+
+
+@cli.command()
+@click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
+@click.option("--out", type=click.Path(path_type=Path), required=True, help="Robots folder or .jar to write.")
+@click.option("--name", default=None, help="Robot class name (default derived from the run).")
+def export(run: Path, out: Path, name: str | None) -> None:
+    """Export a trained policy as a standalone Robocode robot (no Python needed to run it)."""
+    from confront.experiments.evaluate import export_cli
+
+    export_cli(run, out=out, name=name)
+
+
+@cli.command()
+@click.argument("source", type=click.Path(path_type=Path, exists=True))
+@click.option("--out", type=click.Path(path_type=Path), default=None, help="Output stem (default beside the source).")
+def replay(source: Path, out: Path | None) -> None:
+    """Write a GIF and a self-contained HTML player for a replay file or a run's replays."""
+    from confront.experiments.evaluate import replay_cli
+
+    replay_cli(source, out=out)
+
+
+@cli.command()
+@click.argument("what", type=click.Choice(["sim", "learner", "env", "bridge", "reproduce", "all"]), default="sim")
+def bench(what: str) -> None:
+    """Run a benchmark script from benchmarks/ and print its table."""
+    from confront.experiments.evaluate import bench_cli
+
+    bench_cli(what)
+
+
+@cli.group(cls=Group)
+def config() -> None:
+    """Show experiment configs."""
+
+
+@config.command("list")
+def config_list() -> None:
+    """List the packaged experiment configs."""
+    from confront.experiments.spec import list_experiments
+
+    for name in list_experiments():
+        click.echo(name)
+
+
+@config.command("show")
+@click.argument("experiment")
+@set_option
+def config_show(experiment: str, overrides: tuple[str, ...]) -> None:
+    """Print the fully resolved config of EXPERIMENT (a name or a TOML file) as TOML."""
+    from confront.config import to_dict, to_toml
+    from confront.experiments.spec import load_experiment
+
+    click.echo(to_toml(to_dict(load_experiment(experiment, overrides))), nl=False)
+
+
+@cli.group(cls=Group)
+def plot() -> None:
+    """Draw the paper's figures that need no training."""
+
+
+@plot.command("fuzzy")
+@click.option("--out", type=click.Path(path_type=Path), default=Path("fuzzy_learning_rate.png"), show_default=True)
+def plot_fuzzy_cmd(out: Path) -> None:
+    """Figure 13: the fuzzy learning rate as a function of the reward."""
+    from confront.learning.fuzzy import plot_fuzzy
+
+    plot_fuzzy(out)
+    click.echo(f"wrote {out}")
+
+
+def main() -> None:
+    cli(prog_name="confront")
+
+
+if __name__ == "__main__":
+    main()

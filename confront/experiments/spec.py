@@ -1,0 +1,133 @@
+"""Experiment configs: one typed dataclass tree, packaged TOML files per experiment, ``--set`` overrides.
+
+Every free choice the paper leaves open is a key here, with its default and the reason in ``doc``.
+``confront config show NAME`` prints the resolved tree.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Literal
+
+from confront.config import ConfigError, field, from_dict, load_toml, merge, parse_override, to_dict
+
+CONFIG_PACKAGE = "confront.experiments.configs"
+
+
+@dataclass
+class ArenaSection:
+    """The battle: scenario, how many battles run side by side, the SMDP step."""
+
+    scenario: str = field("4v4", doc="named scenario (1v1, 4v4, 4v6, 4v10, melee) or a scenario TOML file")
+    battles: int = field(8, ge=1, le=4096, doc="battles simulated side by side (rounds are shared out)")
+    decision_turns: int = field(10, ge=1, le=500, doc="T: engine turns each macro action is held (SMDP step)")
+    fire_power_actions: bool = field(False, doc="extended action set: 4 moves x 3 bullet powers")
+    target: Literal["nearest", "weakest"] = "nearest"
+
+
+@dataclass
+class OpponentSection:
+    """Who the learning team fights: the TD team (paper §6.3) or scripted robots."""
+
+    kind: str = field("td", doc="'td' for a TD-trained team, or a scripted robot name (e.g. SpinBot)")
+    model: str = field("", doc="saved TD-team model (.npz); empty = train one first and cache it")
+    pretrain_rounds: int = field(300, ge=0, doc="rounds the TD team trains before the experiment")
+    pretrain_against: str = field("SpinBot", doc="scripted robot the TD team trains against")
+    learning: bool = field(False, doc="the TD team keeps learning during the experiment")
+    alpha: float = field(0.2, gt=0.0, le=1.0, doc="TD team's fixed learning rate")
+    gamma: float = field(0.9, ge=0.0, le=1.0)
+    exploit: float = field(0.9, ge=0.0, le=1.0, doc="TD team's epsilon-greedy exploitation threshold (paper's eps)")
+
+
+@dataclass
+class LearnerSection:
+    """The learning team's method (paper §3-4; Table 2)."""
+
+    kind: Literal["dmnn", "ssaq"] = "dmnn"
+    learning_rate: Literal["fuzzy", "fixed"] = field("fuzzy", doc="RL learning rate: fuzzy (Eq. 11-17) or fixed alpha")
+    alpha: float = field(0.1, gt=0.0, le=1.0, doc="fixed RL learning rate (Table 2: 0.1)")
+    gamma: float = field(0.9, ge=0.0, le=1.0, doc="discount (Table 2: 0.9)")
+    t_max: float = field(0.1, gt=0.0, doc="Boltzmann temperature at the start (Table 2: 0.1)")
+    t_min: float = field(0.01, gt=0.0, doc="temperature floor (Table 2: 0.01)")
+    eta: float = field(0.9, ge=0.0, le=1.0, doc="annealing factor (Eq. 7; Table 2: 0.9)")
+    backup: Literal["paper", "smdp"] = field("paper", doc="Eq. 8-10 as corrected in paper-notes §3, or textbook SMDP")
+    hidden: tuple[int, ...] = field((16,), doc="DMNN hidden layer sizes")
+    awm: bool = field(True, doc="adaptive momentum (Eq. 23-24) on; off = plain back-propagation")
+    nn_rate: float = field(0.9, gt=0.0, le=1.0, doc="NN learning rate without AWM (Table 2: 0.9)")
+    momentum: float = field(0.95, ge=0.0, lt=1.0, doc="momentum constant beta (Table 2: 0.95)")
+
+
+@dataclass
+class TransferSection:
+    """Curriculum transfer (paper §5, Eq. 34): act from a source model with a cooling probability."""
+
+    source: str = field("", doc="run folder of the source task; empty = learn from scratch")
+    epsilon0: float = field(0.9, ge=0.0, le=1.0, doc="eps(t0): initial probability of acting from the source")
+    decay: float = field(0.01, ge=0.0, doc="p in eps(t) = eps(t0) exp(-p (t - t0)), t in rounds")
+    floor: float = field(0.05, ge=0.0, le=1.0, doc="stable value eps(t) decays to")
+    init_from_source: bool = field(True, doc="start the learner from the source model's weights (Eq. 33)")
+
+
+@dataclass
+class TrainSection:
+    """Length, sessions, seeds, checkpoints."""
+
+    rounds: int = field(500, ge=1, doc="rounds in total (paper: 500)")
+    session_rounds: int = field(10, ge=1, doc="rounds per session (paper: 10)")
+    seed: int = field(0, ge=0)
+    checkpoint_every: int = field(50, ge=1, doc="rounds between checkpoints")
+    replay: bool = field(True, doc="record the last round of battle 0 as a replay")
+
+
+@dataclass
+class ExperimentConfig:
+    """One training arm."""
+
+    name: str = "demo"
+    description: str = ""
+    arena: ArenaSection = field(default_factory=ArenaSection)
+    opponent: OpponentSection = field(default_factory=OpponentSection)
+    learner: LearnerSection = field(default_factory=LearnerSection)
+    transfer: TransferSection = field(default_factory=TransferSection)
+    train: TrainSection = field(default_factory=TrainSection)
+
+    def __post_init__(self) -> None:
+        if self.learner.t_min > self.learner.t_max:
+            raise ValueError(f"learner.t_min = {self.learner.t_min} must not exceed learner.t_max = {self.learner.t_max}")
+        if self.train.session_rounds > self.train.rounds:
+            raise ValueError(
+                f"train.session_rounds = {self.train.session_rounds} exceeds train.rounds = {self.train.rounds}"
+            )
+
+
+def list_experiments() -> list[str]:
+    """Names of the packaged experiment configs."""
+    root = resources.files(CONFIG_PACKAGE)
+    return sorted(p.name.removesuffix(".toml") for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def experiment_data(name_or_path: str) -> dict:
+    """The raw TOML table of a packaged experiment name or a file path."""
+    if name_or_path.endswith(".toml") or Path(name_or_path).exists():
+        return load_toml(name_or_path)
+    names = list_experiments()
+    if name_or_path not in names:
+        raise ConfigError(f"unknown experiment {name_or_path!r}: use one of {', '.join(names)} or a .toml file")
+    with resources.as_file(resources.files(CONFIG_PACKAGE) / f"{name_or_path}.toml") as p:
+        return load_toml(p)
+
+
+def load_experiment(name_or_path: str, overrides: tuple[str, ...] | list[str] = ()) -> ExperimentConfig:
+    """Resolve an experiment: defaults <- TOML file <- ``key=value`` overrides, validated."""
+    data = to_dict(ExperimentConfig())
+    data = merge(data, experiment_data(name_or_path))
+    for text in overrides:
+        data = merge(data, parse_override(text))
+    return from_dict(ExperimentConfig, data)
+
+
+def config_from_dict(data: dict) -> ExperimentConfig:
+    """Validate a resolved config table (e.g. a run folder's config.toml)."""
+    return from_dict(ExperimentConfig, merge(to_dict(ExperimentConfig()), data))

@@ -95,7 +95,9 @@ class ExperimentConfig:
 
     def __post_init__(self) -> None:
         if self.learner.t_min > self.learner.t_max:
-            raise ValueError(f"learner.t_min = {self.learner.t_min} must not exceed learner.t_max = {self.learner.t_max}")
+            raise ValueError(
+                f"learner.t_min = {self.learner.t_min} must not exceed learner.t_max = {self.learner.t_max}"
+            )
         if self.train.session_rounds > self.train.rounds:
             raise ValueError(
                 f"train.session_rounds = {self.train.session_rounds} exceeds train.rounds = {self.train.rounds}"

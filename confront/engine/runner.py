@@ -1,0 +1,186 @@
+"""Running one battle in the real engine, headless, through the project's control-API runner."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from confront.engine.battle import BattleSpec
+from confront.engine.install import JVM_FLAGS, EngineInstall, find_engine
+from confront.engine.java_build import compile_java
+from confront.engine.results import BattleResults, ScoreRow, parse_results_text
+from confront.engine.workdir import prepare_workdir, write_robot_data
+
+RUNNER_CLASS = "confront.ConfrontRunner"
+
+
+@dataclass(frozen=True)
+class EngineOptions:
+    """How the engine process runs: seed, robot time per turn, sandbox, memory, time limit."""
+
+    seed: int | None = 0
+    cpu_constant_ms: float = 10.0
+    nosecurity: bool = False
+    max_heap_mb: int = 512
+    timeout_s: float = 900.0
+    extra_jvm_args: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.seed is not None and not -(2**63) <= self.seed < 2**63:
+            raise ValueError(f"seed must fit in a Java long, got {self.seed}")
+        if not self.cpu_constant_ms > 0:
+            raise ValueError(f"cpu_constant_ms must be > 0, got {self.cpu_constant_ms}")
+        if not self.timeout_s > 0:
+            raise ValueError(f"timeout_s must be > 0, got {self.timeout_s}")
+
+
+@dataclass(frozen=True)
+class EngineRun:
+    """What one engine run produced: the results table and the run's diagnostics."""
+
+    results: BattleResults
+    results_text: str
+    turns: int
+    robot_turns: int
+    elapsed_s: float
+    setup_s: float
+    round_turns: tuple[int, ...]
+    skipped_turns: dict[str, int]
+    errors: tuple[str, ...] = ()
+    trace: Path | None = None
+    summary: dict = field(default_factory=dict, repr=False)
+
+
+def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: EngineOptions) -> list[str]:
+    """The JVM command line for the runner (flags from robocode-facts.md section 0)."""
+    cmd = [install.java, f"-Xmx{opts.max_heap_mb}M", f"-DWORKINGDIRECTORY={workdir}", *JVM_FLAGS]
+    if opts.seed is not None:
+        cmd.append(f"-DRANDOMSEED={opts.seed}")  # repeatable random order and start positions
+    if opts.nosecurity:
+        cmd.append("-DNOSECURITY=true")  # robots may open loopback sockets (bridge)
+    cmd += list(opts.extra_jvm_args)
+    cmd += ["-cp", f"{install.classpath}{os.pathsep}{classes}", RUNNER_CLASS]
+    return cmd
+
+
+def run_process(cmd: Sequence[str], timeout_s: float, cwd: Path, log: Path) -> int:
+    """Run ``cmd`` in its own process group; kill the whole group on timeout, error or Ctrl-C."""
+    with open(log, "wb") as out:
+        proc = subprocess.Popen(list(cmd), cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
+                                stdin=subprocess.DEVNULL, start_new_session=True)
+        try:
+            return proc.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            raise TimeoutError(f"engine run exceeded {timeout_s} s; see {log}") from None
+        finally:
+            if proc.poll() is None:
+                try:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                except ProcessLookupError:
+                    pass
+                proc.wait()
+
+
+def _row(d: dict, name: str, team: str) -> ScoreRow:
+    s = d["score"]
+    return ScoreRow(
+        name=name, total=s["total"], survival=s["survival"], surv_bonus=s["surv_bonus"],
+        bullet_dmg=s["bullet_dmg"], bullet_bonus=s["bullet_bonus"], ram_dmg=s["ram_dmg"],
+        ram_bonus=s["ram_bonus"], firsts=s["firsts"], seconds=s["seconds"], thirds=s["thirds"], team=team,
+    )
+
+
+def results_from_summary(summary: dict, rounds: int) -> BattleResults:
+    """Exact score parts (doubles from the engine's score snapshots) as :class:`BattleResults`."""
+    conts = [_row(c, c["name"], c["name"]) for c in summary["contestants"]]
+    by_index = {i: c.name for i, c in enumerate(conts)}
+    robots = [_row(r, r["name"], by_index.get(r["contestant"], r["team"])) for r in summary["robots"]]
+    conts.sort(key=lambda r: -r.total)
+    return BattleResults(
+        rounds=rounds, contestants=tuple(conts), robots=tuple(robots),
+        skipped_turns=sum(summary["skipped_turns"].values()),
+    )
+
+
+def run_battle(
+    spec: BattleSpec,
+    options: EngineOptions | None = None,
+    workdir: str | os.PathLike[str] | None = None,
+    trace: str | os.PathLike[str] | None = None,
+    robot_data: Mapping[str, Mapping[str, str]] | None = None,
+    install: EngineInstall | None = None,
+) -> EngineRun:
+    """Run ``spec`` headless in the real engine and return its results.
+
+    ``workdir``: the engine's working directory (created if needed; default a temporary one, removed
+    afterwards). ``trace``: write a JSONL trace of every turn there. ``robot_data``: files for the project's
+    robots' data folders, e.g. ``{"ScriptBot": {"script.txt": ...}}``.
+    """
+    opts = options or EngineOptions()
+    install = install or find_engine()
+    classes = compile_java(install)
+    with tempfile.TemporaryDirectory(prefix="confront-robocode-") as tmp:
+        wd = Path(workdir) if workdir is not None else Path(tmp) / "wd"
+        prepare_workdir(wd, install, classes, opts.cpu_constant_ms, spec.teams)
+        for robot, files in (robot_data or {}).items():
+            write_robot_data(wd, robot, files)
+        run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=tmp))
+        battle_file = run_dir / "battle.battle"
+        battle_file.write_text(spec.battle_file())
+        results_file, summary_file = run_dir / "results.txt", run_dir / "summary.json"
+        args = [str(wd), str(battle_file), str(results_file), str(summary_file)]
+        if trace is not None:
+            args.append(str(Path(trace).resolve()))
+        log = run_dir / "engine.log"
+        code = run_process(java_command(install, classes, wd, opts) + args, opts.timeout_s, run_dir, log)
+        if not summary_file.is_file():
+            tail = log.read_text(errors="replace")[-2000:]
+            raise RuntimeError(f"engine run failed (exit {code}) without a summary:\n{tail}")
+        summary = json.loads(summary_file.read_text())
+        if code != 0 or not summary["completed"]:
+            raise RuntimeError(f"engine run failed (exit {code}): {'; '.join(summary['errors']) or 'no error'}")
+        text = results_file.read_text()
+    file_results = parse_results_text(text)
+    exact = results_from_summary(summary, file_results.rounds)
+    return EngineRun(
+        results=exact, results_text=text, turns=summary["turns"], robot_turns=summary["robot_turns"],
+        elapsed_s=summary["elapsed_s"], setup_s=summary["setup_s"],
+        round_turns=tuple(summary["round_turns"]), skipped_turns=dict(summary["skipped_turns"]),
+        errors=tuple(summary["errors"]), trace=Path(trace) if trace is not None else None, summary=summary,
+    )
+
+
+def run_scenario(
+    scenario: str,
+    ours: str | Sequence[str],
+    opponents: str | Sequence[str],
+    rounds: int = 10,
+    seed: int | None = 0,
+    cpu_constant_ms: float = 10.0,
+    out_dir: str | os.PathLike[str] | None = None,
+) -> EngineRun:
+    """What ``confront battle --engine robocode`` calls: run a named scenario, optionally save the tables.
+
+    With ``out_dir``: results.txt (the engine's own file), results.csv / results.md (exact score parts,
+    contestants), robots.csv (per robot) and summary.json (turns, skipped turns, timings).
+    """
+    from confront.engine.battle import scenario_battle
+
+    spec = scenario_battle(scenario, ours, opponents, rounds=rounds)
+    run = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms))
+    if out_dir is not None:
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "results.txt").write_text(run.results_text)
+        (out / "results.csv").write_text(run.results.to_csv())
+        (out / "robots.csv").write_text(run.results.to_csv(level="robots"))
+        (out / "results.md").write_text(run.results.to_markdown())
+        keep = ("turns", "robot_turns", "elapsed_s", "setup_s", "round_turns", "skipped_turns", "errors")
+        (out / "summary.json").write_text(json.dumps({k: run.summary[k] for k in keep}, indent=1) + "\n")
+    return run

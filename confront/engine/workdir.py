@@ -1,0 +1,69 @@
+"""A private Robocode working directory: config with a fixed CPU constant, robots, teams, script data."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+from confront.engine.battle import TEAM_PACKAGE, Team
+from confront.engine.install import EngineInstall
+from confront.engine.java_build import ROBOT_CLASSES
+
+SAMPLE_PACKAGES: tuple[str, ...] = ("sample", "sampleteam")
+
+
+def prepare_workdir(
+    path: Path,
+    install: EngineInstall,
+    classes: Path,
+    cpu_constant_ms: float = 10.0,
+    teams: Iterable[Team] = (),
+) -> Path:
+    """Create (or refresh) a working directory at ``path`` and return it.
+
+    The CPU constant (robot time per turn) is written to config/robocode.properties so the engine does not
+    run its 5 s benchmark; sample robots and the project's robots are copied into robots/.
+    """
+    if not cpu_constant_ms > 0:
+        raise ValueError(f"cpu_constant_ms must be > 0, got {cpu_constant_ms}")
+    path = Path(path)
+    (path / "config").mkdir(parents=True, exist_ok=True)
+    robots = path / "robots"
+    robots.mkdir(exist_ok=True)
+    # robocode.cpu.constant is in ns [CpuManager]
+    (path / "config" / "robocode.properties").write_text(
+        f"robocode.cpu.constant={int(cpu_constant_ms * 1e6)}\n"
+    )
+    for pkg in SAMPLE_PACKAGES:
+        if not (robots / pkg).is_dir():
+            shutil.copytree(install.samples / pkg, robots / pkg)
+    ours = robots / "confront"
+    ours.mkdir(exist_ok=True)
+    for cls in ROBOT_CLASSES:
+        for f in (classes / "confront").glob(f"{cls}*.class"):
+            if f.stem == cls or f.stem.startswith(cls + "$"):
+                shutil.copy2(f, ours / f.name)
+        (ours / f"{cls}.properties").write_text(
+            f"robot.classname=confront.{cls}\nrobot.name={cls}\nrobocode.version=1.9.3.9\n"
+        )
+    if teams:
+        (robots / TEAM_PACKAGE).mkdir(exist_ok=True)
+        for team in teams:
+            (robots / TEAM_PACKAGE / f"{team.name}.team").write_text(team.team_file())
+    return path
+
+
+def write_robot_data(workdir: Path, robot: str, files: Mapping[str, str]) -> Path:
+    """Write files into the data folder of one of the project's robots (e.g. ScriptBot scripts)."""
+    if robot not in ROBOT_CLASSES:
+        raise ValueError(f"robot must be one of {ROBOT_CLASSES}, got {robot!r}")
+    data = Path(workdir) / "robots" / "confront" / f"{robot}.data"
+    if data.exists():
+        shutil.rmtree(data)
+    data.mkdir(parents=True)
+    for name, text in files.items():
+        if "/" in name or name.startswith("."):
+            raise ValueError(f"bad data file name {name!r}")
+        (data / name).write_text(text)
+    return data

@@ -1,0 +1,42 @@
+"""A short battle of sample robots in the real engine, checked against the engine's own results file."""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+
+from confront.engine.battle import BattleSpec
+from confront.engine.install import JVM_FLAGS, EngineInstall
+from confront.engine.results import parse_results_text
+from confront.engine.runner import EngineOptions, run_battle
+
+pytestmark = pytest.mark.engine
+
+
+def test_sample_battle_matches_engine_results_file(install: EngineInstall, tmp_path) -> None:
+    spec = BattleSpec(("SpinBot", "Walls"), rounds=2)
+    wd = tmp_path / "wd"
+    run = run_battle(spec, EngineOptions(seed=7, cpu_constant_ms=10.0), workdir=wd)
+    # the engine's own command line, same battle, same seed, same working directory
+    battle = tmp_path / "b.battle"
+    battle.write_text(spec.battle_file())
+    results = tmp_path / "engine-results.txt"
+    subprocess.run(
+        [install.java, "-Xmx512M", f"-DWORKINGDIRECTORY={wd}", "-DRANDOMSEED=7", *JVM_FLAGS, "-cp",
+         str(install.jar), "robocode.Robocode", "-battle", str(battle), "-nodisplay", "-nosound",
+         "-results", str(results)],
+        check=True, capture_output=True, timeout=120,
+    )
+    engine = parse_results_text(results.read_text())
+    assert run.results_text == results.read_text()
+    assert run.results.rounded().contestants == engine.contestants
+    res = run.results
+    assert res.rounds == 2 and len(run.round_turns) == 2 and sum(run.round_turns) == run.turns
+    for row in res.contestants:
+        parts = row.survival + row.surv_bonus + row.bullet_dmg + row.bullet_bonus + row.ram_dmg + row.ram_bonus
+        assert row.total == pytest.approx(parts)
+    assert sum(r.firsts for r in res.contestants) == 2
+    assert {r.name for r in res.robots} == {"sample.SpinBot", "sample.Walls"}
+    assert run.skipped_turns == {}
+    assert run.robot_turns >= run.turns  # both alive for most turns

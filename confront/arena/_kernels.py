@@ -1,0 +1,786 @@
+"""Compiled turn kernel: one Robocode turn for every battle of a batch (Battle.runTurn order).
+
+Composes the pure rules of :mod:`confront.arena.rules` over the packed arrays of
+:mod:`confront.arena.state`. Battles run in parallel (``prange``); within a battle the engine's
+sequence is followed exactly. ``order_mode`` 0 = Robocode's random processing order drawn from
+the battle's java.util.Random exactly as the engine consumes it; 1 = one shuffle of the movement
+order per turn (cheaper; same rules); 2 = fixed index order (deterministic, for tests).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from .rules import (
+    BULLET_RADIUS,
+    GUN_TURN_RATE,
+    RADAR_TURN_RATE,
+    ROBOT_HALF,
+    ROBOT_HIT_BONUS,
+    ROBOT_HIT_DAMAGE,
+    TWO_PI,
+    box_contains,
+    boxes_intersect,
+    bullet_damage,
+    bullet_hit_bonus,
+    bullet_speed,
+    clamp_power,
+    distance_until_stop,
+    gun_heat,
+    is_near,
+    java_next_double,
+    java_next_int,
+    new_velocity,
+    normal_absolute_angle,
+    normal_near_absolute_angle,
+    normal_relative_angle,
+    segment_intersects_box,
+    segments_intersect,
+    sweep_hits_box,
+    turn_rate,
+    wall_hit_damage,
+)
+from .state import BB_FIELDS, BF_FIELDS, BI_FIELDS, KF_FIELDS, KI_FIELDS, RB_FIELDS, RF_FIELDS, RI_FIELDS
+
+# field positions inside the packed groups (compile-time constants for numba)
+X, Y, H, GH, RH, V, E, HEAT, BX, BY, DIST, BODYREM, GUNREM, RADREM, MAXV, MAXTURN, ASSIST, \
+    EVWALLB, EVROBB, EVBULB = range(len(RF_FIELDS))
+ALIVE, OVERDRIVE, INCOLL, TRWG, WINNER, ADV, LEADER, DROID, ADJGB, ADJRB, ADJRG, \
+    EVWALL, EVFAULT, EVFIRED, EVDIED = range(len(RB_FIELDS))
+TEAM, EVROBOT, EVHITBY, EVBHIT, EVMISSED = range(len(RI_FIELDS))
+RNG, TIME, ROUND, INACT, ENDT, NB = range(len(BI_FIELDS))
+(INACT_E,) = range(len(BF_FIELDS))
+DECIDED, DONE = range(len(BB_FIELDS))
+KX, KY, KLX, KLY, KH, KP = range(len(KF_FIELDS))
+KOWNER, KVICTIM, KSTATE, KFRAME, KLIST, KLINE = range(len(KI_FIELDS))
+# score parts and placements
+S_SURV, S_LAST, S_BDMG, S_BKILL, S_RAM, S_RKILL = range(6)
+# bullet states (BulletState)
+B_NONE, B_FIRED, B_MOVING, B_HIT_VICTIM, B_HIT_BULLET, B_HIT_WALL, B_EXPLODED = range(7)
+BULLET_EXPLOSION = 17  # BulletPeer.EXPLOSION_LENGTH
+ROBOT_EXPLOSION = 71  # ExplosionPeer.EXPLOSION_LENGTH
+
+# params vector
+P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
+
+
+@njit(cache=True)
+def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
+    """perm[:n] = 0..n-1, shuffled like Collections.shuffle when mode == 0 (swap(i-1, nextInt(i)))."""
+    for i in range(n):
+        perm[i] = i
+    if mode == 0:
+        for i in range(n, 1, -1):
+            rng, j = java_next_int(rng, i)
+            t = perm[i - 1]
+            perm[i - 1] = perm[j]
+            perm[j] = t
+    return rng
+
+
+@njit(cache=True)
+def _reset_inactivity(bi, bf, b, loss):
+    """Battle.resetInactiveTurnCount: every 10 energy lost in total restarts the inactivity counter."""
+    if loss < 0.0:
+        return
+    bf[b, INACT_E] += loss
+    while bf[b, INACT_E] >= 10.0:
+        bf[b, INACT_E] -= 10.0
+        bi[b, INACT] = 0
+
+
+@njit(cache=True)
+def _set_energy(rf, bi, bf, b, i, new_e, reset_inactive):
+    """RobotPeer.setEnergy: below 0.01 becomes 0 and clears movement and body turn."""
+    if reset_inactive and rf[b, E, i] != new_e:
+        _reset_inactivity(bi, bf, b, rf[b, E, i] - new_e)
+    rf[b, E, i] = new_e
+    if new_e < 0.01:
+        rf[b, E, i] = 0.0
+        rf[b, DIST, i] = 0.0
+        rf[b, BODYREM, i] = 0.0
+
+
+@njit(cache=True)
+def _add_list_entry(kf, ki, bi, b, state, owner, x, y, power, heading, victim):
+    """Append an entry to the battle's bullet list (first free slot); returns slot or -1 if full."""
+    k = kf.shape[2]
+    n = bi[b, NB]
+    if n >= k:
+        return -1
+    slot = -1
+    for s in range(k):
+        if ki[b, KSTATE, s] == B_NONE:
+            slot = s
+            break
+    if slot < 0:
+        return -1
+    kf[b, KX, slot] = x
+    kf[b, KY, slot] = y
+    kf[b, KLX, slot] = x
+    kf[b, KLY, slot] = y
+    kf[b, KH, slot] = heading
+    kf[b, KP, slot] = power
+    ki[b, KOWNER, slot] = owner
+    ki[b, KVICTIM, slot] = victim
+    ki[b, KSTATE, slot] = state
+    ki[b, KFRAME, slot] = 0
+    ki[b, KLINE, slot] = 0
+    ki[b, KLIST, n] = slot
+    bi[b, NB] = n + 1
+    return slot
+
+
+@njit(cache=True)
+def _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i):
+    """RobotPeer.kill: +10 to the inactivity ledger, leader's death costs team-mates 30, death explosion."""
+    _reset_inactivity(bi, bf, b, 10.0)
+    n = rf.shape[2]
+    if rb[b, ALIVE, i]:
+        rb[b, EVDIED, i] = True
+        if rb[b, LEADER, i]:
+            for j in range(n):
+                if j != i and rb[b, ALIVE, j] and ri[b, TEAM, j] == ri[b, TEAM, i]:
+                    _set_energy(rf, bi, bf, b, j, rf[b, E, j] - 30.0, True)
+                    _add_list_entry(kf, ki, bi, b, B_HIT_VICTIM, i, rf[b, X, j], rf[b, Y, j], 4.0, 0.0, j)
+        cnt = dead[n]
+        dead[cnt] = i
+        dead[n] = cnt + 1
+        _add_list_entry(kf, ki, bi, b, B_EXPLODED, i, rf[b, X, i], rf[b, Y, i], 1.0, 0.0, i)
+    _set_energy(rf, bi, bf, b, i, 0.0, True)
+    rb[b, ALIVE, i] = False
+
+
+@njit(cache=True)
+def _team_ledger(ri, ledger, b, killer, victim):
+    """Damage the killer's whole team did to the victim this round (RobotStatistics.scoreBulletKill)."""
+    tot = 0.0
+    for t in range(ri.shape[2]):
+        if ri[b, TEAM, t] == ri[b, TEAM, killer]:
+            tot += ledger[b, t, victim]
+    return tot
+
+
+@njit(cache=True)
+def _remove_from_list(ki, bi, b, pos):
+    """Remove list entry at position pos (ArrayList.remove keeps the order); frees its slot."""
+    n = bi[b, NB]
+    slot = ki[b, KLIST, pos]
+    for p in range(pos, n - 1):
+        ki[b, KLIST, p] = ki[b, KLIST, p + 1]
+    bi[b, NB] = n - 1
+    ki[b, KSTATE, slot] = B_NONE
+    ki[b, KOWNER, slot] = -1
+
+
+@njit(cache=True)
+def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params):
+    """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
+    mode = int(params[P_ORDER])
+    n = rf.shape[2]
+    # the engine draws a robot order and a bullet order for every entry, used or not
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+    nbk = bi[b, NB]
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_k, nbk, mode)
+    st = ki[b, KSTATE, s]
+    ki[b, KFRAME, s] += 1
+    if st == B_EXPLODED:
+        o = ki[b, KOWNER, s]
+        kf[b, KX, s] = rf[b, X, o]
+        kf[b, KY, s] = rf[b, Y, o]
+        if ki[b, KFRAME, s] >= ROBOT_EXPLOSION:
+            ki[b, KSTATE, s] = B_NONE
+        return
+    if st == B_FIRED or st == B_MOVING:
+        # movement along the heading at 20 - 3p
+        kf[b, KLX, s] = kf[b, KX, s]
+        kf[b, KLY, s] = kf[b, KY, s]
+        sp = bullet_speed(kf[b, KP, s])
+        kf[b, KX, s] += sp * math.sin(kf[b, KH, s])
+        kf[b, KY, s] += sp * math.cos(kf[b, KH, s])
+        ki[b, KLINE, s] = 1
+        x = kf[b, KX, s]
+        y = kf[b, KY, s]
+        lx = kf[b, KLX, s]
+        ly = kf[b, KLY, s]
+        owner = ki[b, KOWNER, s]
+        # wall test with radius 3 (BulletPeer.checkWallCollision)
+        if x - BULLET_RADIUS <= 0 or y - BULLET_RADIUS <= 0 or x + BULLET_RADIUS >= params[P_W] \
+                or y + BULLET_RADIUS >= params[P_H]:
+            st = B_HIT_WALL
+            ki[b, KFRAME, s] = 0
+            ri[b, EVMISSED, owner] += 1
+        if st == B_FIRED or st == B_MOVING:
+            for q in range(n):
+                j = perm_r[q]
+                if j == owner or not rb[b, ALIVE, j]:
+                    continue
+                if not segment_intersects_box(lx, ly, x, y, rf[b, BX, j], rf[b, BY, j]):
+                    continue
+                st = B_HIT_VICTIM
+                ki[b, KFRAME, s] = 0
+                ki[b, KVICTIM, s] = j
+                p = kf[b, KP, s]
+                dmg = bullet_damage(p)
+                sc = min(dmg, rf[b, E, j])  # damage score capped by the victim's energy
+                _set_energy(rf, bi, bf, b, j, rf[b, E, j] - dmg, True)
+                team_fire = ri[b, TEAM, owner] == ri[b, TEAM, j]
+                if not team_fire:
+                    ledger[b, owner, j] += sc
+                    score[b, owner, S_BDMG] += sc
+                if rf[b, E, j] <= 0.0 and rb[b, ALIVE, j]:
+                    _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, j)
+                    if not team_fire:
+                        score[b, owner, S_BKILL] += 0.2 * _team_ledger(ri, ledger, b, owner, j)
+                # 3p back to the shooter, even if it died this turn (Rules.getBulletHitBonus)
+                _set_energy(rf, bi, bf, b, owner, rf[b, E, owner] + bullet_hit_bonus(p), True)
+                ri[b, EVHITBY, j] += 1
+                rf[b, EVBULB, j] = normal_relative_angle(kf[b, KH, s] + math.pi - rf[b, H, j])
+                ri[b, EVBHIT, owner] += 1
+                if box_contains(rf[b, BX, j], rf[b, BY, j], lx, ly):
+                    kf[b, KX, s] = lx
+                    kf[b, KY, s] = ly
+                break
+        if st == B_FIRED or st == B_MOVING:
+            for q in range(nbk):
+                s2 = ki[b, KLIST, perm_k[q]]
+                st2 = ki[b, KSTATE, s2]
+                if s2 == s or (st2 != B_FIRED and st2 != B_MOVING) or ki[b, KLINE, s2] == 0:
+                    continue
+                if ki[b, KOWNER, s2] == owner:
+                    continue
+                if segments_intersect(lx, ly, x, y, kf[b, KLX, s2], kf[b, KLY, s2], kf[b, KX, s2], kf[b, KY, s2]):
+                    st = B_HIT_BULLET
+                    ki[b, KFRAME, s] = 0
+                    kf[b, KX, s] = lx
+                    kf[b, KY, s] = ly
+                    ki[b, KSTATE, s2] = B_HIT_BULLET
+                    ki[b, KFRAME, s2] = 0
+                    kf[b, KX, s2] = kf[b, KLX, s2]
+                    kf[b, KY, s2] = kf[b, KLY, s2]
+                    break
+    # BulletPeer.updateBulletState
+    if st == B_FIRED:
+        if ki[b, KFRAME, s] > 0:
+            st = B_MOVING
+    elif st == B_HIT_BULLET or st == B_HIT_VICTIM or st == B_HIT_WALL:
+        if ki[b, KFRAME, s] >= BULLET_EXPLOSION:
+            st = B_NONE
+    ki[b, KSTATE, s] = st
+
+
+@njit(cache=True)
+def _turn_body(rf, rb, b, i):
+    """RobotPeer.updateHeading: at most min(maxTurnRate, 10 - 0.75|v|) deg; gun and radar follow."""
+    rem = rf[b, BODYREM, i]
+    if rem == 0.0:
+        return
+    rate = turn_rate(rf[b, V, i], rf[b, MAXTURN, i])
+    if rem > 0.0:
+        step = rem if rem < rate else rate
+    else:
+        step = rem if rem > -rate else -rate
+    rf[b, H, i] += step
+    rf[b, GH, i] += step
+    rf[b, RH, i] += step
+    if rb[b, ADJGB, i]:
+        rf[b, GUNREM, i] -= step
+    if rb[b, ADJRB, i]:
+        rf[b, RADREM, i] -= step
+    rem = 0.0 if step == rem else rem - step
+    rf[b, BODYREM, i] = rem
+    if rem == 0.0:
+        rf[b, H, i] = normal_near_absolute_angle(rf[b, H, i])
+    else:
+        rf[b, H, i] = normal_absolute_angle(rf[b, H, i])
+
+
+@njit(cache=True)
+def _turn_gun(rf, rb, b, i):
+    """RobotPeer.updateGunHeading: at most 20 deg; the radar follows (adjusted if adjustRadarForGun)."""
+    rem = rf[b, GUNREM, i]
+    if rem != 0.0:
+        if rem > 0.0:
+            step = rem if rem < GUN_TURN_RATE else GUN_TURN_RATE
+        else:
+            step = rem if rem > -GUN_TURN_RATE else -GUN_TURN_RATE
+        rf[b, GH, i] += step
+        rf[b, RH, i] += step
+        if rb[b, ADJRG, i]:
+            rf[b, RADREM, i] -= step
+        rf[b, GUNREM, i] = 0.0 if step == rem else rem - step
+    rf[b, GH, i] = normal_absolute_angle(rf[b, GH, i])
+
+
+@njit(cache=True)
+def _turn_radar(rf, b, i):
+    """RobotPeer.updateRadarHeading: at most 45 deg."""
+    rem = rf[b, RADREM, i]
+    if rem != 0.0:
+        if rem > 0.0:
+            step = rem if rem < RADAR_TURN_RATE else RADAR_TURN_RATE
+        else:
+            step = rem if rem > -RADAR_TURN_RATE else -RADAR_TURN_RATE
+        rf[b, RH, i] += step
+        rf[b, RADREM, i] = 0.0 if step == rem else rem - step
+    rf[b, RH, i] = normal_absolute_angle(rf[b, RH, i])
+
+
+@njit(cache=True)
+def _move(rf, rb, b, i):
+    """RobotPeer.updateMovement: getNewVelocity, overdrive flag, remaining distance, position, box."""
+    d = rf[b, DIST, i]
+    if math.isnan(d):
+        d = 0.0
+    v = new_velocity(rf[b, V, i], d, rf[b, MAXV, i])
+    rf[b, V, i] = v
+    if is_near(v, 0.0) and rb[b, OVERDRIVE, i]:
+        d = 0.0
+        rb[b, OVERDRIVE, i] = False
+    if d * v >= 0.0 or math.isnan(d * v):
+        rb[b, OVERDRIVE, i] = distance_until_stop(v) > abs(d)
+    rf[b, DIST, i] = d - v
+    if v != 0.0:
+        rf[b, X, i] += v * math.sin(rf[b, H, i])
+        rf[b, Y, i] += v * math.cos(rf[b, H, i])
+        rf[b, BX, i] = rf[b, X, i]
+        rf[b, BY, i] = rf[b, Y, i]
+
+
+@njit(cache=True)
+def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple[bool, float, float, float]:
+    """RobotPeer.checkWallCollision geometry: (hit, new x, new y, bearing of the wall)."""
+    min_x = ROBOT_HALF
+    min_y = ROBOT_HALF
+    max_x = float(int(w)) - ROBOT_HALF
+    max_y = float(int(hgt)) - ROBOT_HALF
+    ax = 0.0
+    ay = 0.0
+    ang = 0.0
+    hit = True
+    if x < min_x:
+        ax = min_x - x
+        ang = normal_relative_angle(3 * math.pi / 2 - h)
+    elif x > max_x:
+        ax = max_x - x
+        ang = normal_relative_angle(math.pi / 2 - h)
+    elif y < min_y:
+        ay = min_y - y
+        ang = normal_relative_angle(math.pi - h)
+    elif y > max_y:
+        ay = max_y - y
+        ang = normal_relative_angle(-h)
+    else:
+        hit = False
+    if not hit:
+        return False, x, y, 0.0
+    if np.fmod(h, math.pi / 2) != 0.0:  # at an angle: correct the other axis along the heading
+        t = math.tan(h)
+        if ax == 0.0:
+            ax = ay * t
+        elif ay == 0.0:
+            ay = ax / t
+        elif abs(ax / t) > abs(ay):
+            ay = ax / t
+        elif abs(ay * t) > abs(ax):
+            ax = ay * t
+    x = min(max(x + ax, min_x), max_x)
+    y = min(max(y + ay, min_y), max_y)
+    return True, x, y, ang
+
+
+@njit(cache=True)
+def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, i, zap, params):
+    """RobotPeer.performMove for robot i."""
+    n = rf.shape[2]
+    mode = int(params[P_ORDER])
+    if mode == 0:
+        bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+    else:
+        for q in range(n):
+            perm_r[q] = q
+    if not rb[b, ALIVE, i]:
+        return
+    rf[b, HEAT, i] = max(rf[b, HEAT, i] - params[P_COOL], 0.0)  # gun cooling per turn
+    lh = rf[b, H, i]
+    lg = rf[b, GH, i]
+    lr = rf[b, RH, i]
+    lx = rf[b, X, i]
+    ly = rf[b, Y, i]
+    last[b, 0, i] = lg
+    last[b, 1, i] = lr
+    if not rb[b, INCOLL, i]:
+        _turn_body(rf, rb, b, i)
+    _turn_gun(rf, rb, b, i)
+    _turn_radar(rf, b, i)
+    _move(rf, rb, b, i)
+    hit, nx, ny, ang = wall_correction(rf[b, X, i], rf[b, Y, i], rf[b, H, i], params[P_W], params[P_H])
+    if hit:
+        rb[b, EVWALL, i] = True
+        rf[b, EVWALLB, i] = ang
+        rf[b, X, i] = nx
+        rf[b, Y, i] = ny
+        if rb[b, ADV, i]:  # wall damage only for AdvancedRobots, not counted for inactivity
+            _set_energy(rf, bi, bf, b, i, rf[b, E, i] - wall_hit_damage(rf[b, V, i]), False)
+        rf[b, BX, i] = nx
+        rf[b, BY, i] = ny
+        rf[b, DIST, i] = 0.0
+        rf[b, V, i] = 0.0
+    # robot collisions (RobotPeer.checkRobotCollision); the box is not recomputed after moving back
+    rb[b, INCOLL, i] = False
+    for q in range(n):
+        j = perm_r[q]
+        if j == i or not rb[b, ALIVE, j]:
+            continue
+        if not boxes_intersect(rf[b, BX, i], rf[b, BY, i], rf[b, BX, j], rf[b, BY, j]):
+            continue
+        angle = math.atan2(rf[b, X, j] - rf[b, X, i], rf[b, Y, j] - rf[b, Y, i])
+        v = rf[b, V, i]
+        h = rf[b, H, i]
+        bearing = normal_relative_angle(angle - h)
+        if (v > 0 and -math.pi / 2 < bearing < math.pi / 2) or \
+                (v < 0 and (bearing < -math.pi / 2 or bearing > math.pi / 2)):
+            rb[b, INCOLL, i] = True
+            rf[b, V, i] = 0.0
+            rf[b, DIST, i] = 0.0
+            rf[b, X, i] -= v * math.sin(h)
+            rf[b, Y, i] -= v * math.cos(h)
+            team_fire = ri[b, TEAM, i] == ri[b, TEAM, j]
+            if not team_fire:
+                ledger[b, i, j] += ROBOT_HIT_DAMAGE
+                score[b, i, S_RAM] += ROBOT_HIT_BONUS
+            _set_energy(rf, bi, bf, b, i, rf[b, E, i] - ROBOT_HIT_DAMAGE, True)
+            _set_energy(rf, bi, bf, b, j, rf[b, E, j] - ROBOT_HIT_DAMAGE, True)
+            if rf[b, E, j] == 0.0 and rb[b, ALIVE, j]:
+                _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, j)
+                if not team_fire:
+                    score[b, i, S_RKILL] += 0.3 * _team_ledger(ri, ledger, b, i, j)
+            ri[b, EVROBOT, i] = j
+            rf[b, EVROBB, i] = bearing
+            rb[b, EVFAULT, i] = True
+            ri[b, EVROBOT, j] = i
+            rf[b, EVROBB, j] = normal_relative_angle(math.pi + angle - rf[b, H, j])
+    # the radar scans this turn if anything moved or turned
+    last[b, 2, i] = 1.0 if (lh != rf[b, H, i] or lg != rf[b, GH, i] or lr != rf[b, RH, i]
+                            or lx != rf[b, X, i] or ly != rf[b, Y, i]) else 0.0
+    if zap != 0.0:  # inactivity drain (RobotPeer.zap)
+        if rf[b, E, i] == 0.0:
+            _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i)
+            return
+        rf[b, E, i] -= zap
+        if rf[b, E, i] < 0.1:
+            rf[b, E, i] = 0.0
+            rf[b, DIST, i] = 0.0
+            rf[b, BODYREM, i] = 0.0
+
+
+@njit(cache=True)
+def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
+    """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
+    n = rf.shape[2]
+    if mode == 0:
+        bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+    if not rb[b, ALIVE, i]:
+        return
+    rb[b, TRWG, i] = False
+    if last[b, 2, i] == 0.0:
+        return
+    if not rb[b, DROID, i]:
+        start = last[b, 1, i]
+        ext = rf[b, RH, i] - start
+        if ext < -math.pi:
+            ext += TWO_PI
+        elif ext > math.pi:
+            ext -= TWO_PI
+        for j in range(n):
+            if j == i or not rb[b, ALIVE, j]:
+                continue
+            if sweep_hits_box(rf[b, X, i], rf[b, Y, i], start, ext, rf[b, BX, j], rf[b, BY, j]):
+                scanned[b, i, j] = True
+                scan_time[b, i, j] = bi[b, TIME]
+    rb[b, TRWG, i] = (last[b, 0, i] == last[b, 1, i]) and (rf[b, GH, i] == rf[b, RH, i])
+
+
+@njit(cache=True)
+def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                 placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order):
+    """One Robocode turn of battle b (Battle.runTurn)."""
+    n = rf.shape[2]
+    mode = int(params[P_ORDER])
+    bi[b, TIME] += 1
+    for i in range(n):
+        rb[b, EVWALL, i] = False
+        rb[b, EVFAULT, i] = False
+        rb[b, EVFIRED, i] = False
+        rb[b, EVDIED, i] = False
+        ri[b, EVROBOT, i] = -1
+        ri[b, EVHITBY, i] = 0
+        ri[b, EVBHIT, i] = 0
+        ri[b, EVMISSED, i] = 0
+        for j in range(n):
+            scanned[b, i, j] = False
+    dead[n] = 0
+    # 1. load commands (robot list order); a disabled robot cannot set move or body turn
+    for i in range(n):
+        if not rb[b, ALIVE, i]:
+            continue
+        c = cmd[b, i, 0]
+        if not math.isnan(c) and rf[b, E, i] > 0.0:
+            rf[b, DIST, i] = c
+        c = cmd[b, i, 1]
+        if not math.isnan(c) and rf[b, E, i] > 0.0:
+            rf[b, BODYREM, i] = c
+        c = cmd[b, i, 2]
+        if not math.isnan(c):
+            rf[b, GUNREM, i] = c
+        c = cmd[b, i, 3]
+        if not math.isnan(c):
+            rf[b, RADREM, i] = c
+        p = cmd[b, i, 4]
+        assist = rf[b, ASSIST, i]
+        rf[b, ASSIST, i] = math.nan
+        if p > 0.0 and rf[b, HEAT, i] == 0.0 and rf[b, E, i] > 0.0:
+            p = clamp_power(p, rf[b, E, i])
+            _set_energy(rf, bi, bf, b, i, rf[b, E, i] - p, True)
+            rf[b, HEAT, i] += gun_heat(p)
+            hd = rf[b, GH, i]
+            if not rb[b, ADV, i] and rb[b, TRWG, i] and not math.isnan(assist):
+                hd = assist  # fire assist of plain Robots firing from onScannedRobot
+            if _add_list_entry(kf, ki, bi, b, B_FIRED, i, rf[b, X, i], rf[b, Y, i], p, hd, -1) >= 0:
+                rb[b, EVFIRED, i] = True
+    # 2. bullets in random order
+    nb = bi[b, NB]
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, nb, mode)
+    for q in range(nb):
+        order[q] = ki[b, KLIST, perm_d[q]]
+    for q in range(nb):
+        s = order[q]
+        _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params)
+        if ki[b, KSTATE, s] == B_NONE:
+            for p in range(bi[b, NB]):
+                if ki[b, KLIST, p] == s:
+                    _remove_from_list(ki, bi, b, p)
+                    break
+    # 3. robots move, then scan
+    zap = 0.1 if bi[b, INACT] > params[P_INACT] else 0.0
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, 0 if mode <= 1 else 2)
+    for q in range(n):
+        order[q] = perm_d[q]
+    for q in range(n):
+        _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, order[q], zap, params)
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
+    for q in range(n):
+        order[q] = perm_d[q]
+    for q in range(n):
+        _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, order[q], mode)
+    # 4. deaths: placements and +50 survival to every living robot of another team
+    nd = dead[n]
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, nd, mode)
+    for q in range(nd):
+        d = dead[perm_d[q]]
+        td = ri[b, TEAM, d]
+        mates_alive = False
+        for t in range(n):
+            if ri[b, TEAM, t] == td and rb[b, ALIVE, t]:
+                mates_alive = True
+        if not mates_alive:
+            # contestants (teams) other than the dead robot's with someone alive
+            cnt = 0
+            for t in range(n):
+                if rb[b, ALIVE, t] and ri[b, TEAM, t] != td:
+                    first = True
+                    for u in range(t):
+                        if ri[b, TEAM, u] == ri[b, TEAM, t] and rb[b, ALIVE, u]:
+                            first = False
+                            break
+                    if first:
+                        cnt += 1
+            if cnt == 0:
+                if not rb[b, WINNER, d]:
+                    placements[b, d, 0] += 1
+                    placements_total[b, d, 0] += 1
+            elif cnt <= 2:  # 1 enemy left: a second, 2 left: a third
+                placements[b, d, cnt] += 1
+                placements_total[b, d, cnt] += 1
+        bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+        for t in range(n):
+            if rb[b, ALIVE, t] and ri[b, TEAM, t] != td:
+                score[b, t, S_SURV] += 50.0
+    # 5. round decided when at most one team has living robots
+    team0 = -1
+    one_left = True
+    for t in range(n):
+        if rb[b, ALIVE, t]:
+            if team0 < 0:
+                team0 = ri[b, TEAM, t]
+            elif ri[b, TEAM, t] != team0:
+                one_left = False
+                break
+    if one_left:
+        if bi[b, ENDT] == 0:
+            bb[b, DECIDED] = True
+            bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
+            leader_firsts = False
+            win_team = -1
+            for q in range(n):
+                i = perm_d[q]
+                if rb[b, ALIVE, i] and not rb[b, WINNER, i]:
+                    size = 0
+                    for t in range(n):
+                        if ri[b, TEAM, t] == ri[b, TEAM, i]:
+                            size += 1
+                    score[b, i, S_LAST] += 10.0 * (n - 1 - (size - 1))  # 10 per enemy robot
+                    if size == 1 or rb[b, LEADER, i]:
+                        placements[b, i, 0] += 1
+                        placements_total[b, i, 0] += 1
+                    rb[b, WINNER, i] = True
+                    if size > 1:
+                        if rb[b, LEADER, i]:
+                            leader_firsts = True
+                        else:
+                            win_team = ri[b, TEAM, i]
+            if not leader_firsts and win_team >= 0:
+                for t in range(n):
+                    if ri[b, TEAM, t] == win_team and rb[b, LEADER, t]:
+                        placements[b, t, 0] += 1
+                        placements_total[b, t, 0] += 1
+            for i in range(n):
+                for k in range(6):
+                    score_total[b, i, k] += score[b, i, k]
+        bi[b, ENDT] += 1
+        if bi[b, ENDT] > params[P_AFTER]:
+            bb[b, DONE] = True
+    bi[b, INACT] += 1
+    if bi[b, TIME] >= params[P_MAXT] and not bb[b, DONE]:
+        bb[b, DONE] = True
+    # 6. robots woken in random order
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
+
+
+@njit(cache=True, parallel=True)
+def step_batch(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+               placements, placements_total, cmd, params, scratch_i, scratch_f):
+    """Advance every battle that is not done by one turn (parallel over battles)."""
+    nbat = rf.shape[0]
+    n = rf.shape[2]
+    k = kf.shape[2]
+    for b in prange(nbat):
+        if bb[b, DONE]:
+            continue
+        perm_r = scratch_i[b, 0]
+        perm_k = scratch_i[b, 1]
+        perm_d = scratch_i[b, 2]
+        dead = scratch_i[b, 3]
+        order = scratch_i[b, 4]
+        _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                     placements, placements_total, cmd, params, perm_r[:n], perm_k[:k], perm_d, dead[:n + 1],
+                     scratch_f, order)
+
+
+@njit(cache=True)
+def step_serial(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                placements, placements_total, cmd, params, scratch_i, scratch_f):
+    """Same as step_batch without threads (cheaper for one or a few battles)."""
+    nbat = rf.shape[0]
+    n = rf.shape[2]
+    k = kf.shape[2]
+    for b in range(nbat):
+        if bb[b, DONE]:
+            continue
+        _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                     placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
+                     scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
+
+
+@njit(cache=True)
+def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
+                 params, fixed, has_fixed, scratch_i):
+    """Start a new round in battle b (RobotPeer.initializeRound): placement, energies, gun heat 3."""
+    n = rf.shape[2]
+    w = params[P_W]
+    hgt = params[P_H]
+    mode = int(params[P_ORDER])
+    for i in range(n):
+        placed = False
+        if has_fixed:
+            rf[b, X, i] = fixed[i, 0]
+            rf[b, Y, i] = fixed[i, 1]
+            rf[b, H, i] = fixed[i, 2]
+            rf[b, BX, i] = fixed[i, 0]
+            rf[b, BY, i] = fixed[i, 1]
+            placed = _valid_spot(rf, b, i)
+        if not placed:
+            for _ in range(1000):
+                rng = bi[b, RNG]
+                rng, rx = java_next_double(rng)
+                rng, ry = java_next_double(rng)
+                rng, rh = java_next_double(rng)
+                bi[b, RNG] = rng
+                rf[b, X, i] = 2 * ROBOT_HALF + rx * (w - 4 * ROBOT_HALF)
+                rf[b, Y, i] = 2 * ROBOT_HALF + ry * (hgt - 4 * ROBOT_HALF)
+                rf[b, H, i] = TWO_PI * rh
+                rf[b, BX, i] = rf[b, X, i]
+                rf[b, BY, i] = rf[b, Y, i]
+                if _valid_spot(rf, b, i):
+                    break
+        rf[b, GH, i] = rf[b, H, i]
+        rf[b, RH, i] = rf[b, H, i]
+        rb[b, ALIVE, i] = True
+        rb[b, WINNER, i] = False
+        rf[b, V, i] = 0.0
+        e = 100.0
+        if rb[b, LEADER, i]:
+            e += 100.0
+        if rb[b, DROID, i]:
+            e += 20.0
+        rf[b, E, i] = e
+        rf[b, HEAT, i] = 3.0
+        rf[b, DIST, i] = 0.0
+        rf[b, BODYREM, i] = 0.0
+        rf[b, GUNREM, i] = 0.0
+        rf[b, RADREM, i] = 0.0
+        rf[b, ASSIST, i] = math.nan
+        rb[b, OVERDRIVE, i] = False
+        rb[b, INCOLL, i] = False
+        rb[b, TRWG, i] = False
+        rb[b, EVWALL, i] = False
+        rb[b, EVFAULT, i] = False
+        rb[b, EVFIRED, i] = False
+        rb[b, EVDIED, i] = False
+        ri[b, EVROBOT, i] = -1
+        ri[b, EVHITBY, i] = 0
+        ri[b, EVBHIT, i] = 0
+        ri[b, EVMISSED, i] = 0
+        for j in range(n):
+            scanned[b, i, j] = False
+            scan_time[b, i, j] = -1
+            ledger[b, i, j] = 0.0
+        for k in range(6):
+            score[b, i, k] = 0.0
+        for k in range(3):
+            placements[b, i, k] = 0
+    for s in range(kf.shape[2]):
+        ki[b, KSTATE, s] = B_NONE
+        ki[b, KOWNER, s] = -1
+        ki[b, KLINE, s] = 0
+    bi[b, NB] = 0
+    bi[b, TIME] = 0
+    bi[b, ROUND] += 1
+    bi[b, INACT] = 0
+    bi[b, ENDT] = 0
+    bb[b, DECIDED] = False
+    bb[b, DONE] = False
+    # robots started in random order (Battle.initializeRound)
+    bi[b, RNG] = shuffle_into(bi[b, RNG], scratch_i[b, 2], n, mode)
+
+
+@njit(cache=True)
+def _valid_spot(rf, b, i):
+    """No overlap with any other robot's current box (RobotPeer.validSpot; NaN boxes never overlap)."""
+    for j in range(rf.shape[2]):
+        if j != i and boxes_intersect(rf[b, BX, i], rf[b, BY, i], rf[b, BX, j], rf[b, BY, j]):
+            return False
+    return True

@@ -1,0 +1,171 @@
+"""The batched Robocode 1.9.3.9 simulator: ``Arena(scenario, n_battles, seed)``.
+
+Usage::
+
+    arena = Arena("4v4", n_battles=256, seed=1)      # every battle starts its first round
+    cmd = np.full((256, 8, 5), np.nan); cmd[..., 4] = 0.0
+    arena.step(cmd)                                  # one Robocode turn in every battle not done
+    arena.reset(arena.state.done)                    # next round where the round is over
+
+Commands ``(B, R, 5)`` float64, loaded at the start of the turn like an AdvancedRobot's ``set*``
+calls: 0 move distance (px, + ahead), 1 body turn, 2 gun turn, 3 radar turn (radians, + clockwise),
+4 fire power (0 = no fire; clamped to [0.1, 3] and to the energy; refused while the gun is hot).
+NaN in 0-3 keeps the robot's remaining value. A disabled robot (energy 0) cannot set move/body.
+
+State: ``arena.state.<name>`` (NumPy views, battle axis first; B battles, R robots, K bullet slots).
+
+Per battle ``(B,)``: ``rng`` (java.util.Random 48-bit state), ``time`` (turn in the round, 0 at the
+start), ``round`` (rounds started), ``inactive_turns``, ``inactivity_energy``, ``decided`` (at most
+one team left), ``end_timer`` (turns run since decided, the deciding turn counts 1), ``done``
+(round over: decided and ``turns_after_end`` more turns run, or ``max_turns`` reached),
+``n_bullets`` (entries in the bullet list).
+
+Per robot ``(B, R)``: ``x``, ``y`` (centre; y up), ``heading``, ``gun_heading``, ``radar_heading``
+(radians in [0, 2pi), 0 = north, clockwise), ``velocity``, ``energy``, ``gun_heat``, ``box_x``,
+``box_y`` (centre of the collision box; differs from x, y after an at-fault ram, as in Robocode),
+``alive`` (false once dead; a disabled robot is alive with energy 0), remaining command values
+``distance_remaining``, ``body_turn_remaining``, ``gun_turn_remaining``, ``radar_turn_remaining``,
+settings ``max_velocity``, ``max_turn_rate``, ``fire_assist`` (angle for a plain Robot's assisted
+shot this turn, NaN = none; consumed at load), flags ``team`` (int), ``is_advanced`` (wall damage),
+``is_leader`` (200 energy, its death costs team-mates 30), ``is_droid`` (120 energy, no radar),
+``adjust_gun_for_body``, ``adjust_radar_for_body``, ``adjust_radar_for_gun``; internal
+``overdriving``, ``in_collision`` (at fault last turn: no body turn), ``turned_radar_with_gun``,
+``winner``.
+
+Events of the last turn ``(B, R)``: ``ev_hit_wall`` / ``ev_hit_wall_bearing``, ``ev_hit_robot``
+(index of the robot hit, -1 none) / ``ev_hit_robot_bearing`` / ``ev_at_fault``,
+``ev_hit_by_bullet`` (count) / ``ev_hit_by_bullet_bearing``, ``ev_bullet_hit`` (count),
+``ev_bullet_missed`` (count), ``ev_fired``, ``ev_died``.
+
+Radar ``(B, R, R)``: ``scanned[b, i, j]`` robot i's radar swept robot j this turn (Robocode's
+ScannedRobotEvent; its data equals the true end-of-turn state of j, so readers use ``x[b, j]`` etc.),
+``scan_time[b, i, j]`` the turn of the last such scan this round (-1 never).
+
+Scores: ``score`` ``(B, R, 6)`` this round and ``score_total`` summed over decided rounds (copied at
+the deciding turn, as Robocode does), parts in :data:`confront.arena.state.SCORE_PARTS` order
+(survival, last_survivor, bullet_damage, bullet_kill_bonus, ram_damage, ram_kill_bonus);
+``damage_ledger[b, i, j]`` damage i did to j this round (bullets + 0.6 per ram, for kill bonuses);
+``placements`` / ``placements_total`` ``(B, R, 3)`` 1sts, 2nds, 3rds.
+
+Bullets ``(B, K)``: Robocode's bullet list, slots ``b_list[b, :n_bullets]`` in list order:
+``b_x``, ``b_y``, ``b_last_x``, ``b_last_y``, ``b_heading``, ``b_power``, ``b_owner``,
+``b_victim``, ``b_state`` (0 free, 1 fired, 2 moving, 3 hit robot, 4 hit bullet, 5 hit wall,
+6 robot explosion), ``b_frame``, ``b_has_line``.
+
+Seeds: battle b's generator is ``new java.util.Random(seed + b)``, used for start positions and,
+with ``order="engine"``, every random processing order exactly as the engine draws them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _kernels as K
+from .rules import java_seed
+from .scenarios import Scenario, get_scenario
+from .state import FIELDS, ArenaState, allocate
+
+__all__ = ["Arena", "ORDER_MODES"]
+
+ORDER_MODES = {"engine": 0, "shuffle": 1, "fixed": 2}
+_PARALLEL_MIN_BATTLES = 8
+
+
+class Arena:
+    """Many independent Robocode battles of one scenario, advanced together one turn per ``step``."""
+
+    def __init__(self, scenario: Scenario | str, n_battles: int = 1, seed: int = 0, order: str = "engine") -> None:
+        if isinstance(scenario, str):
+            scenario = get_scenario(scenario)
+        if order not in ORDER_MODES:
+            raise ValueError(f"order must be one of {sorted(ORDER_MODES)}, got {order!r}")
+        self.scenario = scenario
+        self.order = order
+        self.state: ArenaState = allocate(scenario, int(n_battles))
+        b, r = self.n_battles, self.n_robots
+        self.params = np.array([scenario.width, scenario.height, scenario.gun_cooling_rate,
+                                scenario.inactivity_time, scenario.max_turns, scenario.turns_after_end,
+                                ORDER_MODES[order]], dtype=np.float64)
+        if scenario.initial_positions is not None:
+            fixed = np.array(scenario.initial_positions, dtype=np.float64)
+            fixed[:, 2] = np.radians(fixed[:, 2])
+            self._fixed, self._has_fixed = fixed, True
+        else:
+            self._fixed, self._has_fixed = np.zeros((r, 3)), False
+        width = max(r, self.state.n_bullet_slots) + 1
+        self._scratch_i = np.zeros((b, 5, width), dtype=np.int32)
+        self._scratch_f = np.zeros((b, 3, r), dtype=np.float64)
+        self.seed(seed)
+        self.reset()
+
+    @property
+    def n_battles(self) -> int:
+        return self.state.n_battles
+
+    @property
+    def n_robots(self) -> int:
+        return self.state.n_robots
+
+    def seed(self, seed: int) -> None:
+        """Seed every battle's java.util.Random with ``seed + b``."""
+        self.state.rng[:] = [java_seed(int(seed) + b) for b in range(self.n_battles)]
+
+    def _mask(self, mask: np.ndarray | None) -> np.ndarray:
+        if mask is None:
+            return np.arange(self.n_battles)
+        m = np.asarray(mask)
+        if m.dtype != np.bool_ or m.shape != (self.n_battles,):
+            raise ValueError(f"mask must be a bool array of shape ({self.n_battles},), got {m.dtype} {m.shape}")
+        return np.flatnonzero(m)
+
+    def reset(self, mask: np.ndarray | None = None) -> None:
+        """Start a new round in the masked battles (all if None); totals carry over."""
+        p = self.state.packed
+        for b in self._mask(mask):
+            K.reset_battle(int(b), p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"],
+                           p["scanned"], p["scan_time"], p["damage_ledger"], p["score"], p["placements"],
+                           self.params, self._fixed, self._has_fixed, self._scratch_i)
+
+    def new_battle(self, mask: np.ndarray | None = None) -> None:
+        """Clear the masked battles' totals and round counters, then start a round."""
+        idx = self._mask(mask)
+        s = self.state
+        for name in ("score_total", "placements_total", "round", "inactivity_energy"):
+            s.arrays[name][idx] = 0
+        self.reset(mask)
+
+    def step(self, commands: np.ndarray) -> None:
+        """Advance every battle that is not done by one turn."""
+        cmd = np.asarray(commands, dtype=np.float64)
+        if cmd.shape != (self.n_battles, self.n_robots, 5):
+            raise ValueError(f"commands must have shape ({self.n_battles}, {self.n_robots}, 5), got {cmd.shape}")
+        if not np.all(np.isfinite(cmd[..., 4])):
+            raise ValueError("commands[..., 4] (fire power) must be finite; use 0 for no fire")
+        p = self.state.packed
+        fn = K.step_batch if self.n_battles >= _PARALLEL_MIN_BATTLES else K.step_serial
+        fn(p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
+           p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
+           p["placements_total"], cmd, self.params, self._scratch_i, self._scratch_f)
+
+    def idle_commands(self) -> np.ndarray:
+        """Commands that keep every remaining value and do not fire."""
+        cmd = np.full((self.n_battles, self.n_robots, 5), math.nan)
+        cmd[..., 4] = 0.0
+        return cmd
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Copies of every state array by name (data only; includes the generators' states)."""
+        return {name: np.array(self.state.arrays[name], copy=True) for name in FIELDS}
+
+    def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
+        """Restore the arrays written by :meth:`state_dict` (same scenario and battle count)."""
+        for name in FIELDS:
+            if name not in d:
+                raise ValueError(f"state dict lacks {name!r}")
+            dst = self.state.arrays[name]
+            src = np.asarray(d[name])
+            if src.shape != dst.shape:
+                raise ValueError(f"state {name!r} has shape {src.shape}, expected {dst.shape}")
+            dst[...] = src

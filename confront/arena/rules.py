@@ -1,0 +1,342 @@
+"""Robocode 1.9.3.9 rules as small compiled pure functions (scalars in, scalars out).
+
+Each function cites the engine rule it follows (``robocode-facts.md`` section, engine class).
+They are ``@njit`` so the turn kernel composes them; they are also callable from Python for tests.
+Angles are radians, 0 = north (+y), positive = clockwise; x right, y up.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = [
+    "ACCELERATION", "DECELERATION", "MAX_VELOCITY", "MAX_TURN_RATE", "GUN_TURN_RATE", "RADAR_TURN_RATE",
+    "RADAR_SCAN_RADIUS", "ROBOT_HALF", "BULLET_RADIUS", "ROBOT_HIT_DAMAGE", "ROBOT_HIT_BONUS",
+    "normal_absolute_angle", "normal_relative_angle", "normal_near_absolute_angle", "is_near",
+    "max_velocity_for_distance", "max_decel", "new_velocity", "distance_until_stop", "turn_rate",
+    "bullet_speed", "bullet_damage", "bullet_hit_bonus", "gun_heat", "clamp_power", "wall_hit_damage",
+    "segments_intersect", "segment_intersects_box", "boxes_intersect", "box_contains",
+    "sweep_hits_box", "java_seed", "java_next", "java_next_double", "java_next_int",
+]
+
+ACCELERATION = 1.0  # Rules.ACCELERATION
+DECELERATION = 2.0  # Rules.DECELERATION
+MAX_VELOCITY = 8.0  # Rules.MAX_VELOCITY
+MAX_TURN_RATE = math.radians(10.0)  # Rules.MAX_TURN_RATE
+GUN_TURN_RATE = math.radians(20.0)  # Rules.GUN_TURN_RATE
+RADAR_TURN_RATE = math.radians(45.0)  # Rules.RADAR_TURN_RATE
+RADAR_SCAN_RADIUS = 1200.0  # Rules.RADAR_SCAN_RADIUS
+ROBOT_HALF = 18.0  # RobotPeer.WIDTH / 2 (36x36 box)
+BULLET_RADIUS = 3.0  # BulletPeer.RADIUS (wall test)
+ROBOT_HIT_DAMAGE = 0.6  # Rules.ROBOT_HIT_DAMAGE
+ROBOT_HIT_BONUS = 1.2  # Rules.ROBOT_HIT_BONUS
+NEAR_DELTA = 1e-5  # Utils.NEAR_DELTA
+TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def normal_absolute_angle(a: float) -> float:
+    """Angle in [0, 2pi) (Utils.normalAbsoluteAngle; Java's % on doubles is C fmod)."""
+    a = np.fmod(a, TWO_PI)
+    return a if a >= 0.0 else a + TWO_PI
+
+
+@njit(cache=True)
+def normal_relative_angle(a: float) -> float:
+    """Angle in [-pi, pi) (Utils.normalRelativeAngle)."""
+    a = np.fmod(a, TWO_PI)
+    if a >= 0.0:
+        return a if a < math.pi else a - TWO_PI
+    return a if a >= -math.pi else a + TWO_PI
+
+
+@njit(cache=True)
+def is_near(a: float, b: float) -> bool:
+    """|a - b| < 1e-5 (Utils.isNear)."""
+    return abs(a - b) < NEAR_DELTA
+
+
+@njit(cache=True)
+def normal_near_absolute_angle(a: float) -> float:
+    """normal_absolute_angle, snapped onto 0/90/180/270 deg when within 1e-5 (Utils.normalNearAbsoluteAngle)."""
+    a = normal_absolute_angle(a)
+    if is_near(a, math.pi):
+        return math.pi
+    if a < math.pi:
+        if is_near(a, 0.0):
+            return 0.0
+        if is_near(a, math.pi / 2):
+            return math.pi / 2
+    else:
+        if is_near(a, 3 * math.pi / 2):
+            return 3 * math.pi / 2
+        if is_near(a, TWO_PI):
+            return 0.0
+    return a
+
+
+@njit(cache=True)
+def max_velocity_for_distance(d: float) -> float:
+    """Highest speed from which braking by 2/turn stops exactly after d (RobotPeer.getMaxVelocity)."""
+    t = max(1.0, math.ceil((math.sqrt(4.0 * d + 1.0) - 1.0) / 2.0))  # decel time, quadratic formula
+    if math.isinf(t):
+        return MAX_VELOCITY
+    brake = (t / 2.0) * (t - 1.0) * DECELERATION  # sum 0..t-1 of the braking steps
+    return (t - 1.0) * DECELERATION + (d - brake) / t
+
+
+@njit(cache=True)
+def max_decel(speed: float) -> float:
+    """Speed change when reversing: brake by 2, the rest of the turn accelerates by 1 (RobotPeer.maxDecel)."""
+    decel_time = speed / DECELERATION
+    return min(1.0, decel_time) * DECELERATION + max(0.0, 1.0 - decel_time) * ACCELERATION
+
+
+@njit(cache=True)
+def new_velocity(v: float, d: float, max_v: float = MAX_VELOCITY) -> float:
+    """Next velocity for remaining distance d (RobotPeer.getNewVelocity; mirrored for d < 0)."""
+    sign = 1.0
+    if d < 0.0:
+        sign = -1.0
+        v = -v
+        d = -d
+    if math.isinf(d):
+        goal = max_v
+    else:
+        goal = min(max_velocity_for_distance(d), max_v)
+    if v >= 0.0:
+        return sign * max(v - DECELERATION, min(goal, v + ACCELERATION))
+    return sign * max(v - ACCELERATION, min(goal, v + max_decel(-v)))
+
+
+@njit(cache=True)
+def distance_until_stop(v: float) -> float:
+    """Distance covered when braking from |v| to 0 (RobotPeer.getDistanceTraveledUntilStop)."""
+    dist = 0.0
+    v = abs(v)
+    while v > 0.0:
+        v = new_velocity(v, 0.0)
+        dist += v
+    return dist
+
+
+@njit(cache=True)
+def turn_rate(v: float, max_rate: float = MAX_TURN_RATE) -> float:
+    """Body turn limit min(maxTurnRate, (0.4 + 0.6(1 - |v|/8)) * 10 deg) = 10 - 0.75|v| deg (updateHeading)."""
+    return min(max_rate, (0.4 + 0.6 * (1.0 - abs(v) / MAX_VELOCITY)) * MAX_TURN_RATE)
+
+
+@njit(cache=True)
+def clamp_power(p: float, energy: float) -> float:
+    """Fire power clamped to [0.1, 3] and to the energy (RobotPeer.fireBullets)."""
+    return min(energy, min(max(p, 0.1), 3.0))
+
+
+@njit(cache=True)
+def bullet_speed(p: float) -> float:
+    """20 - 3p (Rules.getBulletSpeed)."""
+    return 20.0 - 3.0 * p
+
+
+@njit(cache=True)
+def bullet_damage(p: float) -> float:
+    """4p, plus 2(p - 1) above power 1 (Rules.getBulletDamage)."""
+    d = 4.0 * p
+    if p > 1.0:
+        d += 2.0 * (p - 1.0)
+    return d
+
+
+@njit(cache=True)
+def bullet_hit_bonus(p: float) -> float:
+    """Energy returned to the shooter on a hit: 3p (Rules.getBulletHitBonus)."""
+    return 3.0 * p
+
+
+@njit(cache=True)
+def gun_heat(p: float) -> float:
+    """Gun heat added by firing: 1 + p/5 (Rules.getGunHeat)."""
+    return 1.0 + p / 5.0
+
+
+@njit(cache=True)
+def wall_hit_damage(v: float) -> float:
+    """max(|v|/2 - 1, 0) (Rules.getWallHitDamage)."""
+    return max(abs(v) / 2.0 - 1.0, 0.0)
+
+
+@njit(cache=True)
+def segments_intersect(x1: float, y1: float, x2: float, y2: float,
+                       x3: float, y3: float, x4: float, y4: float) -> bool:
+    """Line-segment intersection as BulletPeer.intersect (parallel segments never meet: division by 0)."""
+    dx13 = x1 - x3
+    dx21 = x2 - x1
+    dx43 = x4 - x3
+    dy13 = y1 - y3
+    dy21 = y2 - y1
+    dy43 = y4 - y3
+    dn = dy43 * dx21 - dx43 * dy21
+    if dn == 0.0:
+        return False
+    ua = (dx43 * dy13 - dy43 * dx13) / dn
+    ub = (dx21 * dy13 - dy21 * dx13) / dn
+    return 0.0 <= ua <= 1.0 and 0.0 <= ub <= 1.0
+
+
+@njit(cache=True)
+def _outcode(px: float, py: float, rx: float, ry: float, rw: float, rh: float) -> int:
+    """Rectangle2D.outcode: bits left 1, top(low y) 2, right 4, bottom(high y) 8."""
+    out = 0
+    if px < rx:
+        out |= 1
+    elif px > rx + rw:
+        out |= 4
+    if py < ry:
+        out |= 2
+    elif py > ry + rh:
+        out |= 8
+    return out
+
+
+@njit(cache=True)
+def segment_intersects_rect(x1: float, y1: float, x2: float, y2: float,
+                            rx: float, ry: float, rw: float, rh: float) -> bool:
+    """Closed segment vs closed rectangle (Rectangle2D.intersectsLine, Cohen-Sutherland style)."""
+    out2 = _outcode(x2, y2, rx, ry, rw, rh)
+    if out2 == 0:
+        return True
+    while True:
+        out1 = _outcode(x1, y1, rx, ry, rw, rh)
+        if out1 == 0:
+            return True
+        if (out1 & out2) != 0:
+            return False
+        if (out1 & 5) != 0:
+            x = rx
+            if (out1 & 4) != 0:
+                x += rw
+            y1 = y1 + (x - x1) * (y2 - y1) / (x2 - x1)
+            x1 = x
+        else:
+            y = ry
+            if (out1 & 8) != 0:
+                y += rh
+            x1 = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
+            y1 = y
+
+
+@njit(cache=True)
+def segment_intersects_box(x1: float, y1: float, x2: float, y2: float, cx: float, cy: float) -> bool:
+    """Bullet segment vs a robot's 36x36 box centred on (cx, cy) (BulletPeer.checkRobotCollision)."""
+    return segment_intersects_rect(x1, y1, x2, y2, cx - ROBOT_HALF, cy - ROBOT_HALF, 2 * ROBOT_HALF, 2 * ROBOT_HALF)
+
+
+@njit(cache=True)
+def boxes_intersect(ax: float, ay: float, bx: float, by: float) -> bool:
+    """Two 36x36 boxes overlap with positive area (Rectangle2D.intersects is strict)."""
+    return abs(ax - bx) < 2 * ROBOT_HALF and abs(ay - by) < 2 * ROBOT_HALF
+
+
+@njit(cache=True)
+def box_contains(cx: float, cy: float, px: float, py: float) -> bool:
+    """Point inside a 36x36 box, left/bottom edges included (Rectangle2D.contains)."""
+    return cx - ROBOT_HALF <= px < cx + ROBOT_HALF and cy - ROBOT_HALF <= py < cy + ROBOT_HALF
+
+
+@njit(cache=True)
+def _in_sweep(dx: float, dy: float, start: float, extent: float, r: float) -> bool:
+    """Point (relative to the centre) within radius r and inside the swept angle range."""
+    if dx * dx + dy * dy > r * r:
+        return False
+    if extent == 0.0:
+        return False
+    a = math.atan2(dx, dy)
+    if extent > 0.0:
+        rel = normal_absolute_angle(a - start)
+        return rel <= extent
+    rel = normal_absolute_angle(start - a)
+    return rel <= -extent
+
+
+@njit(cache=True)
+def sweep_hits_box(x: float, y: float, start: float, extent: float, cx: float, cy: float,
+                   r: float = RADAR_SCAN_RADIUS) -> bool:
+    """Radar pie from heading ``start`` over ``extent`` (signed, |extent| <= pi) of radius r hits a box.
+
+    RobotPeer.scan: the box intersects the start line of the sweep or the pie (Arc2D.PIE intersects).
+    """
+    rx = cx - ROBOT_HALF
+    ry = cy - ROBOT_HALF
+    w = 2 * ROBOT_HALF
+    sx = x + r * math.sin(start)
+    sy = y + r * math.cos(start)
+    if segment_intersects_rect(x, y, sx, sy, rx, ry, w, w):
+        return True
+    if extent == 0.0:
+        return False
+    end = start + extent
+    ex = x + r * math.sin(end)
+    ey = y + r * math.cos(end)
+    if segment_intersects_rect(x, y, ex, ey, rx, ry, w, w):
+        return True
+    # a corner inside the pie
+    for k in range(4):
+        px = rx + (w if (k & 1) else 0.0)
+        py = ry + (w if (k & 2) else 0.0)
+        if _in_sweep(px - x, py - y, start, extent, r):
+            return True
+    # the arc bulging into a side: the box point nearest each cardinal extreme of the circle
+    for k in range(4):
+        a = k * math.pi / 2
+        qx = min(max(x + r * math.sin(a), rx), rx + w)
+        qy = min(max(y + r * math.cos(a), ry), ry + w)
+        if _in_sweep(qx - x, qy - y, start, extent, r):
+            return True
+    return False
+
+
+# java.util.Random: 48-bit LCG (seed * 0x5DEECE66D + 0xB) mod 2^48
+_MULT = 0x5DEECE66D
+_MASK = (1 << 48) - 1
+
+
+@njit(cache=True)
+def java_seed(seed: int) -> int:
+    """Initial scrambled state of ``new java.util.Random(seed)``."""
+    return (seed ^ _MULT) & _MASK
+
+
+@njit(cache=True)
+def java_next(state: int, bits: int) -> tuple[int, int]:
+    """java.util.Random.next(bits): (new state, value as a signed 32-bit int)."""
+    state = (state * _MULT + 0xB) & _MASK
+    v = state >> (48 - bits)
+    if v >= (1 << 31):
+        v -= 1 << 32
+    return state, v
+
+
+@njit(cache=True)
+def java_next_double(state: int) -> tuple[int, float]:
+    """java.util.Random.nextDouble: ((next(26) << 27) + next(27)) * 2^-53."""
+    state, a = java_next(state, 26)
+    state, b = java_next(state, 27)
+    return state, ((a << 27) + b) * (1.0 / (1 << 53))
+
+
+@njit(cache=True)
+def java_next_int(state: int, bound: int) -> tuple[int, int]:
+    """java.util.Random.nextInt(bound) with its rejection rule."""
+    state, r = java_next(state, 31)
+    m = bound - 1
+    if (bound & m) == 0:
+        return state, (bound * r) >> 31
+    u = r
+    r = u % bound
+    while u - r + m >= (1 << 31):  # int overflow in Java makes this negative
+        state, u = java_next(state, 31)
+        r = u % bound
+    return state, r

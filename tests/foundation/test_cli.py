@@ -1,0 +1,50 @@
+"""The command line: resolved configs, and user mistakes as one line on stderr with exit code 2."""
+
+import subprocess
+import sys
+import tomllib
+
+import pytest
+from click.testing import CliRunner
+
+from confront.cli.main import cli
+
+
+def test_config_show_prints_full_resolved_config() -> None:
+    result = CliRunner().invoke(cli, ["config", "show", "awm", "--set", "learner.alpha=0.2"])
+    assert result.exit_code == 0, result.output
+    data = tomllib.loads(result.output)
+    assert data["learner"]["alpha"] == 0.2
+    assert data["learner"]["momentum"] == 0.95  # Table 2
+    assert data["train"]["rounds"] == 500 and data["train"]["session_rounds"] == 10
+    assert set(data) >= {"arena", "opponent", "learner", "transfer", "train"}
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--set", "learner.alpha=2"], "error: learner.alpha = 2.0 is out of range: must be > 0.0 and <= 1.0"),
+        (["--set", "learner.alpah=0.2"], "error: unknown key 'learner.alpah': allowed keys here are"),
+        (["--set", "train.rounds=many"], "error: train.rounds = 'many' has the wrong type: expected an integer"),
+        (["--set", "learner.kind=\"dqn\""], "error: learner.kind = 'dqn' is not allowed: use one of 'dmnn', 'ssaq'"),
+        (["--set", "learner.t_min=0.5"], "error: learner.t_min = 0.5 must not exceed learner.t_max = 0.1"),
+        (["--set", "rounds"], "error: --set 'rounds' must look like key.path=value"),
+    ],
+)
+def test_bad_overrides_exit_2_with_one_line(args: list[str], message: str) -> None:
+    proc = subprocess.run([sys.executable, "-m", "confront.cli.main", "config", "show", "demo", *args],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(message)
+    assert len(proc.stderr.strip().splitlines()) == 1
+    assert "Traceback" not in proc.stderr
+
+
+def test_unknown_experiment_and_bad_toml(tmp_path) -> None:
+    result = CliRunner().invoke(cli, ["config", "show", "nosuch"])
+    assert result.exit_code == 2
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[learner\nalpha = 1")
+    result = CliRunner().invoke(cli, ["config", "show", str(bad)])
+    assert result.exit_code == 2
+    assert "is not valid TOML" in result.output

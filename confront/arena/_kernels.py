@@ -17,6 +17,7 @@ from numba import njit, prange
 from .rules import (
     BULLET_RADIUS,
     GUN_TURN_RATE,
+    RADAR_SCAN_RADIUS,
     RADAR_TURN_RATE,
     ROBOT_HALF,
     ROBOT_HIT_BONUS,
@@ -38,8 +39,9 @@ from .rules import (
     normal_near_absolute_angle,
     normal_relative_angle,
     segment_intersects_box,
+    segment_intersects_rect,
     segments_intersect,
-    sweep_hits_box,
+    sweep_hits_box_uv,
     turn_rate,
     wall_hit_damage,
 )
@@ -67,7 +69,7 @@ ROBOT_EXPLOSION = 71  # ExplosionPeer.EXPLOSION_LENGTH
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     """perm[:n] = 0..n-1, shuffled like Collections.shuffle when mode == 0 (swap(i-1, nextInt(i)))."""
     for i in range(n):
@@ -81,7 +83,7 @@ def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     return rng
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _reset_inactivity(bi, bf, b, loss):
     """Battle.resetInactiveTurnCount: every 10 energy lost in total restarts the inactivity counter."""
     if loss < 0.0:
@@ -92,7 +94,7 @@ def _reset_inactivity(bi, bf, b, loss):
         bi[b, INACT] = 0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _set_energy(rf, bi, bf, b, i, new_e, reset_inactive):
     """RobotPeer.setEnergy: below 0.01 becomes 0 and clears movement and body turn."""
     if reset_inactive and rf[b, E, i] != new_e:
@@ -104,7 +106,7 @@ def _set_energy(rf, bi, bf, b, i, new_e, reset_inactive):
         rf[b, BODYREM, i] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _add_list_entry(kf, ki, bi, b, state, owner, x, y, power, heading, victim):
     """Append an entry to the battle's bullet list (first free slot); returns slot or -1 if full."""
     k = kf.shape[2]
@@ -134,7 +136,7 @@ def _add_list_entry(kf, ki, bi, b, state, owner, x, y, power, heading, victim):
     return slot
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i):
     """RobotPeer.kill: +10 to the inactivity ledger, leader's death costs team-mates 30, death explosion."""
     _reset_inactivity(bi, bf, b, 10.0)
@@ -154,7 +156,7 @@ def _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i):
     rb[b, ALIVE, i] = False
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _team_ledger(ri, ledger, b, killer, victim):
     """Damage the killer's whole team did to the victim this round (RobotStatistics.scoreBulletKill)."""
     tot = 0.0
@@ -164,7 +166,7 @@ def _team_ledger(ri, ledger, b, killer, victim):
     return tot
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _remove_from_list(ki, bi, b, pos):
     """Remove list entry at position pos (ArrayList.remove keeps the order); frees its slot."""
     n = bi[b, NB]
@@ -176,7 +178,7 @@ def _remove_from_list(ki, bi, b, pos):
     ki[b, KOWNER, slot] = -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params):
     """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
     mode = int(params[P_ORDER])
@@ -272,7 +274,7 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
     ki[b, KSTATE, s] = st
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_body(rf, rb, b, i):
     """RobotPeer.updateHeading: at most min(maxTurnRate, 10 - 0.75|v|) deg; gun and radar follow."""
     rem = rf[b, BODYREM, i]
@@ -298,7 +300,7 @@ def _turn_body(rf, rb, b, i):
         rf[b, H, i] = normal_absolute_angle(rf[b, H, i])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_gun(rf, rb, b, i):
     """RobotPeer.updateGunHeading: at most 20 deg; the radar follows (adjusted if adjustRadarForGun)."""
     rem = rf[b, GUNREM, i]
@@ -315,7 +317,7 @@ def _turn_gun(rf, rb, b, i):
     rf[b, GH, i] = normal_absolute_angle(rf[b, GH, i])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_radar(rf, b, i):
     """RobotPeer.updateRadarHeading: at most 45 deg."""
     rem = rf[b, RADREM, i]
@@ -329,7 +331,7 @@ def _turn_radar(rf, b, i):
     rf[b, RH, i] = normal_absolute_angle(rf[b, RH, i])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _move(rf, rb, b, i):
     """RobotPeer.updateMovement: getNewVelocity, overdrive flag, remaining distance, position, box."""
     d = rf[b, DIST, i]
@@ -350,7 +352,7 @@ def _move(rf, rb, b, i):
         rf[b, BY, i] = rf[b, Y, i]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple[bool, float, float, float]:
     """RobotPeer.checkWallCollision geometry: (hit, new x, new y, bearing of the wall)."""
     min_x = ROBOT_HALF
@@ -392,7 +394,7 @@ def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple
     return True, x, y, ang
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, i, zap, params):
     """RobotPeer.performMove for robot i."""
     n = rf.shape[2]
@@ -477,7 +479,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             rf[b, BODYREM, i] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
     n = rf.shape[2]
@@ -495,16 +497,31 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
             ext += TWO_PI
         elif ext > math.pi:
             ext -= TWO_PI
+        ux = math.sin(start)
+        uy = math.cos(start)
+        vx = math.sin(start + ext)
+        vy = math.cos(start + ext)
+        xi = rf[b, X, i] + ROBOT_HALF
+        yi = rf[b, Y, i] + ROBOT_HALF
         for j in range(n):
             if j == i or not rb[b, ALIVE, j]:
                 continue
-            if sweep_hits_box(rf[b, X, i], rf[b, Y, i], start, ext, rf[b, BX, j], rf[b, BY, j]):
+            x0 = rf[b, BX, j] - xi
+            y0 = rf[b, BY, j] - yi
+            if ext >= 0.0:
+                hit = sweep_hits_box_uv(x0, y0, ux, uy, vx, vy, ext != 0.0, RADAR_SCAN_RADIUS)
+            else:
+                hit = sweep_hits_box_uv(x0, y0, vx, vy, ux, uy, True, RADAR_SCAN_RADIUS)
+                if not hit:
+                    hit = segment_intersects_rect(0.0, 0.0, RADAR_SCAN_RADIUS * ux, RADAR_SCAN_RADIUS * uy,
+                                                  x0, y0, 2 * ROBOT_HALF, 2 * ROBOT_HALF)
+            if hit:
                 scanned[b, i, j] = True
                 scan_time[b, i, j] = bi[b, TIME]
     rb[b, TRWG, i] = (last[b, 0, i] == last[b, 1, i]) and (rf[b, GH, i] == rf[b, RH, i])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                  placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order):
     """One Robocode turn of battle b (Battle.runTurn)."""
@@ -660,7 +677,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def step_batch(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                placements, placements_total, cmd, params, scratch_i, scratch_f):
     """Advance every battle that is not done by one turn (parallel over battles)."""
@@ -680,7 +697,7 @@ def step_batch(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score
                      scratch_f, order)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def step_serial(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                 placements, placements_total, cmd, params, scratch_i, scratch_f):
     """Same as step_batch without threads (cheaper for one or a few battles)."""
@@ -695,7 +712,7 @@ def step_serial(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, scor
                      scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
                  params, fixed, has_fixed, scratch_i):
     """Start a new round in battle b (RobotPeer.initializeRound): placement, energies, gun heat 3."""
@@ -777,7 +794,7 @@ def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bi[b, RNG] = shuffle_into(bi[b, RNG], scratch_i[b, 2], n, mode)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _valid_spot(rf, b, i):
     """No overlap with any other robot's current box (RobotPeer.validSpot; NaN boxes never overlap)."""
     for j in range(rf.shape[2]):

@@ -19,7 +19,7 @@ __all__ = [
     "max_velocity_for_distance", "max_decel", "new_velocity", "distance_until_stop", "turn_rate",
     "bullet_speed", "bullet_damage", "bullet_hit_bonus", "gun_heat", "clamp_power", "wall_hit_damage",
     "segments_intersect", "segment_intersects_box", "boxes_intersect", "box_contains",
-    "sweep_hits_box", "java_seed", "java_next", "java_next_double", "java_next_int",
+    "sweep_hits_box", "sweep_hits_box_uv", "java_seed", "java_next", "java_next_double", "java_next_int",
 ]
 
 ACCELERATION = 1.0  # Rules.ACCELERATION
@@ -37,14 +37,14 @@ NEAR_DELTA = 1e-5  # Utils.NEAR_DELTA
 TWO_PI = 2.0 * math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def normal_absolute_angle(a: float) -> float:
     """Angle in [0, 2pi) (Utils.normalAbsoluteAngle; Java's % on doubles is C fmod)."""
     a = np.fmod(a, TWO_PI)
     return a if a >= 0.0 else a + TWO_PI
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def normal_relative_angle(a: float) -> float:
     """Angle in [-pi, pi) (Utils.normalRelativeAngle)."""
     a = np.fmod(a, TWO_PI)
@@ -53,13 +53,13 @@ def normal_relative_angle(a: float) -> float:
     return a if a >= -math.pi else a + TWO_PI
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def is_near(a: float, b: float) -> bool:
     """|a - b| < 1e-5 (Utils.isNear)."""
     return abs(a - b) < NEAR_DELTA
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def normal_near_absolute_angle(a: float) -> float:
     """normal_absolute_angle, snapped onto 0/90/180/270 deg when within 1e-5 (Utils.normalNearAbsoluteAngle)."""
     a = normal_absolute_angle(a)
@@ -78,7 +78,7 @@ def normal_near_absolute_angle(a: float) -> float:
     return a
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def max_velocity_for_distance(d: float) -> float:
     """Highest speed from which braking by 2/turn stops exactly after d (RobotPeer.getMaxVelocity)."""
     t = max(1.0, math.ceil((math.sqrt(4.0 * d + 1.0) - 1.0) / 2.0))  # decel time, quadratic formula
@@ -88,14 +88,14 @@ def max_velocity_for_distance(d: float) -> float:
     return (t - 1.0) * DECELERATION + (d - brake) / t
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def max_decel(speed: float) -> float:
     """Speed change when reversing: brake by 2, the rest of the turn accelerates by 1 (RobotPeer.maxDecel)."""
     decel_time = speed / DECELERATION
     return min(1.0, decel_time) * DECELERATION + max(0.0, 1.0 - decel_time) * ACCELERATION
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def new_velocity(v: float, d: float, max_v: float = MAX_VELOCITY) -> float:
     """Next velocity for remaining distance d (RobotPeer.getNewVelocity; mirrored for d < 0)."""
     sign = 1.0
@@ -112,36 +112,36 @@ def new_velocity(v: float, d: float, max_v: float = MAX_VELOCITY) -> float:
     return sign * max(v - ACCELERATION, min(goal, v + max_decel(-v)))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def distance_until_stop(v: float) -> float:
     """Distance covered when braking from |v| to 0 (RobotPeer.getDistanceTraveledUntilStop)."""
     dist = 0.0
     v = abs(v)
     while v > 0.0:
-        v = new_velocity(v, 0.0)
+        v = max(v - DECELERATION, 0.0)  # = new_velocity(v, 0) for v > 0: the goal speed at d = 0 is 0
         dist += v
     return dist
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def turn_rate(v: float, max_rate: float = MAX_TURN_RATE) -> float:
     """Body turn limit min(maxTurnRate, (0.4 + 0.6(1 - |v|/8)) * 10 deg) = 10 - 0.75|v| deg (updateHeading)."""
     return min(max_rate, (0.4 + 0.6 * (1.0 - abs(v) / MAX_VELOCITY)) * MAX_TURN_RATE)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def clamp_power(p: float, energy: float) -> float:
     """Fire power clamped to [0.1, 3] and to the energy (RobotPeer.fireBullets)."""
     return min(energy, min(max(p, 0.1), 3.0))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def bullet_speed(p: float) -> float:
     """20 - 3p (Rules.getBulletSpeed)."""
     return 20.0 - 3.0 * p
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def bullet_damage(p: float) -> float:
     """4p, plus 2(p - 1) above power 1 (Rules.getBulletDamage)."""
     d = 4.0 * p
@@ -150,25 +150,25 @@ def bullet_damage(p: float) -> float:
     return d
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def bullet_hit_bonus(p: float) -> float:
     """Energy returned to the shooter on a hit: 3p (Rules.getBulletHitBonus)."""
     return 3.0 * p
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def gun_heat(p: float) -> float:
     """Gun heat added by firing: 1 + p/5 (Rules.getGunHeat)."""
     return 1.0 + p / 5.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def wall_hit_damage(v: float) -> float:
     """max(|v|/2 - 1, 0) (Rules.getWallHitDamage)."""
     return max(abs(v) / 2.0 - 1.0, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def segments_intersect(x1: float, y1: float, x2: float, y2: float,
                        x3: float, y3: float, x4: float, y4: float) -> bool:
     """Line-segment intersection as BulletPeer.intersect (parallel segments never meet: division by 0)."""
@@ -186,7 +186,7 @@ def segments_intersect(x1: float, y1: float, x2: float, y2: float,
     return 0.0 <= ua <= 1.0 and 0.0 <= ub <= 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _outcode(px: float, py: float, rx: float, ry: float, rw: float, rh: float) -> int:
     """Rectangle2D.outcode: bits left 1, top(low y) 2, right 4, bottom(high y) 8."""
     out = 0
@@ -201,7 +201,7 @@ def _outcode(px: float, py: float, rx: float, ry: float, rw: float, rh: float) -
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def segment_intersects_rect(x1: float, y1: float, x2: float, y2: float,
                             rx: float, ry: float, rw: float, rh: float) -> bool:
     """Closed segment vs closed rectangle (Rectangle2D.intersectsLine, Cohen-Sutherland style)."""
@@ -228,74 +228,102 @@ def segment_intersects_rect(x1: float, y1: float, x2: float, y2: float,
             y1 = y
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def segment_intersects_box(x1: float, y1: float, x2: float, y2: float, cx: float, cy: float) -> bool:
     """Bullet segment vs a robot's 36x36 box centred on (cx, cy) (BulletPeer.checkRobotCollision)."""
     return segment_intersects_rect(x1, y1, x2, y2, cx - ROBOT_HALF, cy - ROBOT_HALF, 2 * ROBOT_HALF, 2 * ROBOT_HALF)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def boxes_intersect(ax: float, ay: float, bx: float, by: float) -> bool:
     """Two 36x36 boxes overlap with positive area (Rectangle2D.intersects is strict)."""
     return abs(ax - bx) < 2 * ROBOT_HALF and abs(ay - by) < 2 * ROBOT_HALF
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def box_contains(cx: float, cy: float, px: float, py: float) -> bool:
     """Point inside a 36x36 box, left/bottom edges included (Rectangle2D.contains)."""
     return cx - ROBOT_HALF <= px < cx + ROBOT_HALF and cy - ROBOT_HALF <= py < cy + ROBOT_HALF
 
 
-@njit(cache=True)
-def _in_sweep(dx: float, dy: float, start: float, extent: float, r: float) -> bool:
-    """Point (relative to the centre) within radius r and inside the swept angle range."""
-    if dx * dx + dy * dy > r * r:
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _in_wedge(px: float, py: float, ux: float, uy: float, vx: float, vy: float, r: float) -> bool:
+    """Point (relative to the centre) within radius r, clockwise from direction u to v (angle <= pi)."""
+    if px * px + py * py > r * r:
         return False
-    if extent == 0.0:
-        return False
-    a = math.atan2(dx, dy)
-    if extent > 0.0:
-        rel = normal_absolute_angle(a - start)
-        return rel <= extent
-    rel = normal_absolute_angle(start - a)
-    return rel <= -extent
+    return ux * py - uy * px <= 0.0 and vx * py - vy * px >= 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
+def sweep_hits_box_uv(x0: float, y0: float, ux: float, uy: float, vx: float, vy: float,
+                      turned: bool, r: float) -> bool:
+    """Pie test with the box's lower-left corner (x0, y0) relative to the centre and unit vectors.
+
+    u is the start direction and v the end direction of a clockwise sweep of at most pi (callers swap
+    them for an anticlockwise sweep); ``turned`` is False for a zero sweep (only the start line counts).
+    """
+    w = 2 * ROBOT_HALF
+    x1 = x0 + w
+    y1 = y0 + w
+    # nearest point of the box to the centre beyond the radius: nothing to see
+    nx = min(max(0.0, x0), x1)
+    ny = min(max(0.0, y0), y1)
+    if nx * nx + ny * ny > r * r:
+        return False
+    # all corners strictly anticlockwise of the start line's half-plane, or clockwise of the end's
+    c0 = ux * y0 - uy * x0
+    c1 = ux * y0 - uy * x1
+    c2 = ux * y1 - uy * x0
+    c3 = ux * y1 - uy * x1
+    if c0 > 0.0 and c1 > 0.0 and c2 > 0.0 and c3 > 0.0:
+        return False
+    if turned:
+        d0 = vx * y0 - vy * x0
+        d1 = vx * y0 - vy * x1
+        d2 = vx * y1 - vy * x0
+        d3 = vx * y1 - vy * x1
+        if d0 < 0.0 and d1 < 0.0 and d2 < 0.0 and d3 < 0.0:
+            return False
+    if segment_intersects_rect(0.0, 0.0, r * ux, r * uy, x0, y0, w, w):
+        return True
+    if not turned:
+        return False
+    if segment_intersects_rect(0.0, 0.0, r * vx, r * vy, x0, y0, w, w):
+        return True
+    for k in range(4):
+        px = x1 if (k & 1) else x0
+        py = y1 if (k & 2) else y0
+        if _in_wedge(px, py, ux, uy, vx, vy, r):
+            return True
+    # the arc bulging into a side: the box point nearest each cardinal extreme of the circle
+    for k in range(4):
+        qx = min(max(r * ((k == 1) - (k == 3)), x0), x1)
+        qy = min(max(r * ((k == 0) - (k == 2)), y0), y1)
+        if _in_wedge(qx, qy, ux, uy, vx, vy, r):
+            return True
+    return False
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
 def sweep_hits_box(x: float, y: float, start: float, extent: float, cx: float, cy: float,
                    r: float = RADAR_SCAN_RADIUS) -> bool:
     """Radar pie from heading ``start`` over ``extent`` (signed, |extent| <= pi) of radius r hits a box.
 
     RobotPeer.scan: the box intersects the start line of the sweep or the pie (Arc2D.PIE intersects).
     """
-    rx = cx - ROBOT_HALF
-    ry = cy - ROBOT_HALF
+    ux = math.sin(start)
+    uy = math.cos(start)
+    vx = math.sin(start + extent)
+    vy = math.cos(start + extent)
+    x0 = cx - ROBOT_HALF - x
+    y0 = cy - ROBOT_HALF - y
+    if extent >= 0.0:
+        return sweep_hits_box_uv(x0, y0, ux, uy, vx, vy, extent != 0.0, r)
+    # anticlockwise: the same pie swept clockwise from the end; the start line must still count
     w = 2 * ROBOT_HALF
-    sx = x + r * math.sin(start)
-    sy = y + r * math.cos(start)
-    if segment_intersects_rect(x, y, sx, sy, rx, ry, w, w):
+    if segment_intersects_rect(0.0, 0.0, r * ux, r * uy, x0, y0, w, w):
         return True
-    if extent == 0.0:
-        return False
-    end = start + extent
-    ex = x + r * math.sin(end)
-    ey = y + r * math.cos(end)
-    if segment_intersects_rect(x, y, ex, ey, rx, ry, w, w):
-        return True
-    # a corner inside the pie
-    for k in range(4):
-        px = rx + (w if (k & 1) else 0.0)
-        py = ry + (w if (k & 2) else 0.0)
-        if _in_sweep(px - x, py - y, start, extent, r):
-            return True
-    # the arc bulging into a side: the box point nearest each cardinal extreme of the circle
-    for k in range(4):
-        a = k * math.pi / 2
-        qx = min(max(x + r * math.sin(a), rx), rx + w)
-        qy = min(max(y + r * math.cos(a), ry), ry + w)
-        if _in_sweep(qx - x, qy - y, start, extent, r):
-            return True
-    return False
+    return sweep_hits_box_uv(x0, y0, vx, vy, ux, uy, True, r)
 
 
 # java.util.Random: 48-bit LCG (seed * 0x5DEECE66D + 0xB) mod 2^48
@@ -303,13 +331,13 @@ _MULT = 0x5DEECE66D
 _MASK = (1 << 48) - 1
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def java_seed(seed: int) -> int:
     """Initial scrambled state of ``new java.util.Random(seed)``."""
     return (seed ^ _MULT) & _MASK
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def java_next(state: int, bits: int) -> tuple[int, int]:
     """java.util.Random.next(bits): (new state, value as a signed 32-bit int)."""
     state = (state * _MULT + 0xB) & _MASK
@@ -319,7 +347,7 @@ def java_next(state: int, bits: int) -> tuple[int, int]:
     return state, v
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def java_next_double(state: int) -> tuple[int, float]:
     """java.util.Random.nextDouble: ((next(26) << 27) + next(27)) * 2^-53."""
     state, a = java_next(state, 26)
@@ -327,7 +355,7 @@ def java_next_double(state: int) -> tuple[int, float]:
     return state, ((a << 27) + b) * (1.0 / (1 << 53))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, error_model="numpy")
 def java_next_int(state: int, bound: int) -> tuple[int, int]:
     """java.util.Random.nextInt(bound) with its rejection rule."""
     state, r = java_next(state, 31)

@@ -64,6 +64,7 @@ class BattleSpec:
     inactivity_time: int = 450
     initial_positions: tuple[Position, ...] = ()
     name: str = "custom"
+    max_turns: int = 0  # stop the battle at this turn of its first round (0 = play it out); for traces
     teams: tuple[Team, ...] = field(init=False, default=())
 
     def __post_init__(self) -> None:
@@ -78,6 +79,8 @@ class BattleSpec:
             raise ValueError(f"field must be 400..5000 on each side, got {self.width}x{self.height}")
         if not 0.1 <= self.gun_cooling_rate <= 0.7:
             raise ValueError(f"gun_cooling_rate must be in [0.1, 0.7], got {self.gun_cooling_rate}")
+        if self.max_turns < 0:
+            raise ValueError(f"max_turns must be >= 0, got {self.max_turns}")
         if self.inactivity_time < 0:
             raise ValueError(f"inactivity_time must be >= 0, got {self.inactivity_time}")
         if len(self.initial_positions) > self.robot_count:
@@ -110,6 +113,8 @@ class BattleSpec:
             f"robocode.battle.selectedRobots={self.selected_robots()}",
             f"confront.expectedRobots={self.robot_count}",
         ]
+        if self.max_turns:
+            lines.append(f"confront.maxTurns={self.max_turns}")
         if self.initial_positions:
             lines.append(f"robocode.battle.initialPositions={format_positions(self.initial_positions)}")
         return "\n".join(lines) + "\n"

@@ -6,6 +6,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -42,7 +43,10 @@ class EngineOptions:
 
 @dataclass(frozen=True)
 class EngineRun:
-    """What one engine run produced: the results table and the run's diagnostics."""
+    """What one engine run produced: the results table and the run's diagnostics.
+
+    ``results_text`` is the engine's own results file ("" when the battle was stopped at ``max_turns``).
+    """
 
     results: BattleResults
     results_text: str
@@ -54,6 +58,7 @@ class EngineRun:
     skipped_turns: dict[str, int]
     errors: tuple[str, ...] = ()
     trace: Path | None = None
+    stopped_at_turn: int = -1
     summary: dict = field(default_factory=dict, repr=False)
 
 
@@ -69,11 +74,22 @@ def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: Eng
     return cmd
 
 
+def _die_with_parent() -> None:  # pragma: no cover - runs in the child between fork and exec
+    """Ask Linux to kill the child when the Python process dies (prctl PR_SET_PDEATHSIG)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)
+    except (OSError, AttributeError):
+        pass
+
+
 def run_process(cmd: Sequence[str], timeout_s: float, cwd: Path, log: Path) -> int:
     """Run ``cmd`` in its own process group; kill the whole group on timeout, error or Ctrl-C."""
     with open(log, "wb") as out:
         proc = subprocess.Popen(list(cmd), cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL, start_new_session=True)
+                                stdin=subprocess.DEVNULL, start_new_session=True,
+                                preexec_fn=_die_with_parent if sys.platform == "linux" else None)
         try:
             return proc.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
@@ -146,13 +162,14 @@ def run_battle(
         if code != 0 or not summary["completed"]:
             raise RuntimeError(f"engine run failed (exit {code}): {'; '.join(summary['errors']) or 'no error'}")
         text = results_file.read_text()
-    file_results = parse_results_text(text)
-    exact = results_from_summary(summary, file_results.rounds)
+    rounds = parse_results_text(text).rounds if summary["stopped_at_turn"] < 0 else 1
+    exact = results_from_summary(summary, rounds)
     return EngineRun(
         results=exact, results_text=text, turns=summary["turns"], robot_turns=summary["robot_turns"],
         elapsed_s=summary["elapsed_s"], setup_s=summary["setup_s"],
         round_turns=tuple(summary["round_turns"]), skipped_turns=dict(summary["skipped_turns"]),
-        errors=tuple(summary["errors"]), trace=Path(trace) if trace is not None else None, summary=summary,
+        errors=tuple(summary["errors"]), trace=Path(trace) if trace is not None else None,
+        stopped_at_turn=summary["stopped_at_turn"], summary=summary,
     )
 
 

@@ -54,6 +54,9 @@ public final class ConfrontRunner extends BattleAdaptor {
     private final List<String> messages = new ArrayList<>();
     private ITurnSnapshot last;
     private BattleCompletedEvent completed;
+    private RobocodeEngine engine;
+    private int maxTurns;
+    private int abortedAt = -1;
 
     private ConfrontRunner(Writer trace) {
         this.trace = trace;
@@ -75,6 +78,8 @@ public final class ConfrontRunner extends BattleAdaptor {
         RobocodeEngine.setLogMessagesEnabled(false);
         RobocodeEngine engine = new RobocodeEngine(new File(args[0]));
         ConfrontRunner runner = new ConfrontRunner(trace);
+        runner.engine = engine;
+        runner.maxTurns = Integer.parseInt(battle.getProperty("confront.maxTurns", "0"));
         engine.addBattleListener(runner);
         int exit = 0;
         try {
@@ -99,7 +104,7 @@ public final class ConfrontRunner extends BattleAdaptor {
                 }
                 String positions = battle.getProperty("robocode.battle.initialPositions");
                 engine.runBattle(spec, positions, true);
-                if (runner.completed == null) {
+                if (runner.completed == null && runner.abortedAt < 0) {
                     runner.errors.add("battle did not complete");
                     exit = 4;
                 }
@@ -170,31 +175,50 @@ public final class ConfrontRunner extends BattleAdaptor {
             }
         }
         last = snap;
+        if (abortedAt >= 0) {
+            return;
+        }
         if (trace != null) {
             writeTurn(snap, "turn");
+        }
+        if (maxTurns > 0 && snap.getTurn() >= maxTurns) {
+            abortedAt = snap.getTurn();
+            if (trace != null) {
+                writeScores("stopped", snap.getRound(), snap.getTurn(), snap);
+            }
+            // aborting waits for the battle thread, which is the caller here: do it from another thread
+            Thread stopper = new Thread(engine::abortCurrentBattle, "confront-stop");
+            stopper.setDaemon(true);
+            stopper.start();
         }
     }
 
     @Override
     public void onRoundEnded(RoundEndedEvent event) {
         roundTurns.add(event.getTurns());
-        if (trace != null && last != null) {
-            StringBuilder b = new StringBuilder();
-            b.append("{\"type\":\"round_end\",\"round\":").append(event.getRound())
-                    .append(",\"turns\":").append(event.getTurns()).append(",\"robots\":[");
-            IRobotSnapshot[] rs = last.getRobots();
-            for (int i = 0; i < rs.length; i++) {
-                if (i > 0) {
-                    b.append(',');
-                }
-                b.append("{\"index\":").append(i).append(",\"name\":").append(str(rs[i].getName()))
-                        .append(",\"score\":");
-                score(b, rs[i].getScoreSnapshot());
-                b.append('}');
-            }
-            b.append("]}\n");
-            write(b.toString());
+        if (trace != null && last != null && abortedAt < 0) {
+            writeScores("round_end", event.getRound(), event.getTurns(), last);
         }
+    }
+
+    private void writeScores(String type, int round, int turns, ITurnSnapshot snap) {
+        StringBuilder b = new StringBuilder();
+        b.append("{\"type\":\"").append(type).append("\",\"round\":").append(round)
+                .append(",\"turns\":").append(turns).append(",\"robots\":[");
+        IRobotSnapshot[] rs = snap.getRobots();
+        for (int i = 0; i < rs.length; i++) {
+            if (i > 0) {
+                b.append(',');
+            }
+            b.append("{\"index\":").append(i).append(",\"name\":").append(str(rs[i].getName()))
+                    .append(",\"score\":");
+            score(b, rs[i].getScoreSnapshot());
+            b.append(",\"current\":");
+            current(b, rs[i].getScoreSnapshot());
+            b.append('}');
+        }
+        b.append("]}\n");
+        write(b.toString());
     }
 
     @Override
@@ -289,7 +313,8 @@ public final class ConfrontRunner extends BattleAdaptor {
     private void writeSummary(String path, int nRobots) throws IOException {
         StringBuilder b = new StringBuilder();
         double elapsed = (System.nanoTime() - startNanos) / 1e9;
-        b.append("{\"completed\":").append(completed != null)
+        b.append("{\"completed\":").append(completed != null || abortedAt >= 0)
+                .append(",\"stopped_at_turn\":").append(abortedAt)
                 .append(",\"robots_requested\":").append(nRobots)
                 .append(",\"turns\":").append(turns).append(",\"robot_turns\":").append(robotTurns)
                 .append(",\"elapsed_s\":").append(elapsed)
@@ -363,6 +388,16 @@ public final class ConfrontRunner extends BattleAdaptor {
                 .append(",\"firsts\":").append(s.getTotalFirsts())
                 .append(",\"seconds\":").append(s.getTotalSeconds())
                 .append(",\"thirds\":").append(s.getTotalThirds()).append('}');
+    }
+
+    private static void current(StringBuilder b, IScoreSnapshot s) {
+        b.append("{\"total\":").append(s.getCurrentScore())
+                .append(",\"survival\":").append(s.getCurrentSurvivalScore())
+                .append(",\"surv_bonus\":").append(s.getCurrentSurvivalBonus())
+                .append(",\"bullet_dmg\":").append(s.getCurrentBulletDamageScore())
+                .append(",\"bullet_bonus\":").append(s.getCurrentBulletKillBonus())
+                .append(",\"ram_dmg\":").append(s.getCurrentRammingDamageScore())
+                .append(",\"ram_bonus\":").append(s.getCurrentRammingKillBonus()).append('}');
     }
 
     private static void appendStrings(StringBuilder b, List<String> items) {

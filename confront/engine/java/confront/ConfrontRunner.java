@@ -43,7 +43,7 @@ import robocode.control.snapshot.ITurnSnapshot;
 public final class ConfrontRunner extends BattleAdaptor {
     private final Writer trace;
     private final long startNanos = System.nanoTime();
-    private long roundStartNanos;
+    private long lastTurnNanos = System.nanoTime();
     private long setupNanos;
     private boolean firstTurnOfRound;
     private long turns;
@@ -144,7 +144,6 @@ public final class ConfrontRunner extends BattleAdaptor {
 
     @Override
     public void onRoundStarted(RoundStartedEvent event) {
-        roundStartNanos = System.nanoTime();
         firstTurnOfRound = true;
         if (trace != null) {
             writeTurn(event.getStartSnapshot(), "round_start");
@@ -154,10 +153,13 @@ public final class ConfrontRunner extends BattleAdaptor {
     @Override
     public void onTurnEnded(TurnEndedEvent event) {
         ITurnSnapshot snap = event.getTurnSnapshot();
+        long now = System.nanoTime();
         if (firstTurnOfRound) {
-            setupNanos += System.nanoTime() - roundStartNanos;
+            // time from the previous round's last turn (or engine start) to this round's first turn
+            setupNanos += now - lastTurnNanos;
             firstTurnOfRound = false;
         }
+        lastTurnNanos = now;
         turns++;
         for (IRobotSnapshot r : snap.getRobots()) {
             if (r.getState() != robocode.control.snapshot.RobotState.DEAD) {

@@ -31,10 +31,10 @@ class Group(click.Group):
 
 def _engine_errors() -> tuple[type[BaseException], ...]:
     try:
-        from confront.engine import EngineError  # type: ignore[attr-defined]
+        from confront.engine import EngineNotFoundError
     except ImportError:
         return ()
-    return (EngineError,)
+    return (EngineNotFoundError,)
 
 
 def set_option(f: Callable[..., Any]) -> Callable[..., Any]:

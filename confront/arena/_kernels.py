@@ -32,6 +32,7 @@ from .rules import (
     distance_until_stop,
     gun_heat,
     is_near,
+    java_next,
     java_next_double,
     java_next_int,
     new_velocity,
@@ -80,6 +81,24 @@ def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
             t = perm[i - 1]
             perm[i - 1] = perm[j]
             perm[j] = t
+    return rng
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def skip_shuffle(rng: int, n: int, mode: int) -> int:
+    """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
+
+    Used where the engine's order cannot change the outcome (or is rebuilt lazily when it can).
+    """
+    if mode != 0:
+        return rng
+    for i in range(n, 1, -1):
+        rng, u = java_next(rng, 31)
+        if (i & (i - 1)) != 0 and u >= (1 << 31) - i:  # nextInt's rejection is only possible up here
+            r = u % i
+            while u - r + i - 1 >= (1 << 31):
+                rng, u = java_next(rng, 31)
+                r = u % i
     return rng
 
 
@@ -183,10 +202,12 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
     """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
     mode = int(params[P_ORDER])
     n = rf.shape[2]
-    # the engine draws a robot order and a bullet order for every entry, used or not
-    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+    # the engine draws a robot order and a bullet order for every entry, used or not; the orders
+    # are only built when two or more candidates make them matter
+    rng0 = bi[b, RNG]
+    rng1 = skip_shuffle(rng0, n, mode)
     nbk = bi[b, NB]
-    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_k, nbk, mode)
+    bi[b, RNG] = skip_shuffle(rng1, nbk, mode)
     st = ki[b, KSTATE, s]
     ki[b, KFRAME, s] += 1
     if st == B_EXPLODED:
@@ -216,8 +237,15 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
             ki[b, KFRAME, s] = 0
             ri[b, EVMISSED, owner] += 1
         if st == B_FIRED or st == B_MOVING:
-            for q in range(n):
-                j = perm_r[q]
+            cand = 0
+            for j in range(n):
+                if j != owner and rb[b, ALIVE, j] and \
+                        segment_intersects_box(lx, ly, x, y, rf[b, BX, j], rf[b, BY, j]):
+                    cand += 1
+            if cand >= 2:
+                shuffle_into(rng0, perm_r, n, mode)
+            for q in range(n if cand > 0 else 0):
+                j = perm_r[q] if cand >= 2 else q
                 if j == owner or not rb[b, ALIVE, j]:
                     continue
                 if not segment_intersects_box(lx, ly, x, y, rf[b, BX, j], rf[b, BY, j]):
@@ -247,8 +275,18 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
                     kf[b, KY, s] = ly
                 break
         if st == B_FIRED or st == B_MOVING:
+            cand = 0
             for q in range(nbk):
-                s2 = ki[b, KLIST, perm_k[q]]
+                s2 = ki[b, KLIST, q]
+                st2 = ki[b, KSTATE, s2]
+                if s2 != s and (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KLINE, s2] != 0 and \
+                        ki[b, KOWNER, s2] != owner and segments_intersect(
+                            lx, ly, x, y, kf[b, KLX, s2], kf[b, KLY, s2], kf[b, KX, s2], kf[b, KY, s2]):
+                    cand += 1
+            if cand >= 2:
+                shuffle_into(rng1, perm_k, nbk, mode)
+            for q in range(nbk if cand > 0 else 0):
+                s2 = ki[b, KLIST, perm_k[q] if cand >= 2 else q]
                 st2 = ki[b, KSTATE, s2]
                 if s2 == s or (st2 != B_FIRED and st2 != B_MOVING) or ki[b, KLINE, s2] == 0:
                     continue
@@ -399,11 +437,8 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
     """RobotPeer.performMove for robot i."""
     n = rf.shape[2]
     mode = int(params[P_ORDER])
-    if mode == 0:
-        bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
-    else:
-        for q in range(n):
-            perm_r[q] = q
+    rng0 = bi[b, RNG]
+    bi[b, RNG] = skip_shuffle(rng0, n, mode)
     if not rb[b, ALIVE, i]:
         return
     rf[b, HEAT, i] = max(rf[b, HEAT, i] - params[P_COOL], 0.0)  # gun cooling per turn
@@ -433,8 +468,14 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
         rf[b, V, i] = 0.0
     # robot collisions (RobotPeer.checkRobotCollision); the box is not recomputed after moving back
     rb[b, INCOLL, i] = False
-    for q in range(n):
-        j = perm_r[q]
+    cand = 0
+    for j in range(n):
+        if j != i and rb[b, ALIVE, j] and boxes_intersect(rf[b, BX, i], rf[b, BY, i], rf[b, BX, j], rf[b, BY, j]):
+            cand += 1
+    if cand >= 2:  # the engine's robot order decides which collision comes first
+        shuffle_into(rng0, perm_r, n, mode)
+    for q in range(n if cand > 0 else 0):
+        j = perm_r[q] if cand >= 2 else q
         if j == i or not rb[b, ALIVE, j]:
             continue
         if not boxes_intersect(rf[b, BX, i], rf[b, BY, i], rf[b, BX, j], rf[b, BY, j]):
@@ -483,8 +524,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
 def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
     n = rf.shape[2]
-    if mode == 0:
-        bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+    bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)  # scan order changes nothing
     if not rb[b, ALIVE, i]:
         return
     rb[b, TRWG, i] = False
@@ -588,16 +628,14 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
         order[q] = perm_d[q]
     for q in range(n):
         _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, order[q], zap, params)
-    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
+    bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
     for q in range(n):
-        order[q] = perm_d[q]
-    for q in range(n):
-        _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, order[q], mode)
+        _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, q, mode)
     # 4. deaths: placements and +50 survival to every living robot of another team
     nd = dead[n]
-    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, nd, mode)
+    bi[b, RNG] = skip_shuffle(bi[b, RNG], nd, mode)  # placements do not depend on this order
     for q in range(nd):
-        d = dead[perm_d[q]]
+        d = dead[q]
         td = ri[b, TEAM, d]
         mates_alive = False
         for t in range(n):
@@ -622,7 +660,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
             elif cnt <= 2:  # 1 enemy left: a second, 2 left: a third
                 placements[b, d, cnt] += 1
                 placements_total[b, d, cnt] += 1
-        bi[b, RNG] = shuffle_into(bi[b, RNG], perm_r, n, mode)
+        bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
         for t in range(n):
             if rb[b, ALIVE, t] and ri[b, TEAM, t] != td:
                 score[b, t, S_SURV] += 50.0
@@ -639,11 +677,10 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     if one_left:
         if bi[b, ENDT] == 0:
             bb[b, DECIDED] = True
-            bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
+            bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)  # the outcome does not depend on this order
             leader_firsts = False
             win_team = -1
-            for q in range(n):
-                i = perm_d[q]
+            for i in range(n):
                 if rb[b, ALIVE, i] and not rb[b, WINNER, i]:
                     size = 0
                     for t in range(n):
@@ -674,7 +711,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     if bi[b, TIME] >= params[P_MAXT] and not bb[b, DONE]:
         bb[b, DONE] = True
     # 6. robots woken in random order
-    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)
+    bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -791,7 +828,16 @@ def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bb[b, DECIDED] = False
     bb[b, DONE] = False
     # robots started in random order (Battle.initializeRound)
-    bi[b, RNG] = shuffle_into(bi[b, RNG], scratch_i[b, 2], n, mode)
+    bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def reset_many(idx, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
+               params, fixed, has_fixed, scratch_i):
+    """reset_battle for every battle index in idx."""
+    for q in range(idx.shape[0]):
+        reset_battle(idx[q], rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
+                     params, fixed, has_fixed, scratch_i)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")

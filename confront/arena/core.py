@@ -123,10 +123,11 @@ class Arena:
     def reset(self, mask: np.ndarray | None = None) -> None:
         """Start a new round in the masked battles (all if None); totals carry over."""
         p = self.state.packed
-        for b in self._mask(mask):
-            K.reset_battle(int(b), p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"],
-                           p["scanned"], p["scan_time"], p["damage_ledger"], p["score"], p["placements"],
-                           self.params, self._fixed, self._has_fixed, self._scratch_i)
+        idx = self._mask(mask).astype(np.int64)
+        if idx.size:
+            K.reset_many(idx, p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"],
+                         p["scanned"], p["scan_time"], p["damage_ledger"], p["score"], p["placements"],
+                         self.params, self._fixed, self._has_fixed, self._scratch_i)
 
     def new_battle(self, mask: np.ndarray | None = None) -> None:
         """Clear the masked battles' totals and round counters, then start a round."""

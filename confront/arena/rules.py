@@ -40,6 +40,8 @@ TWO_PI = 2.0 * math.pi
 @njit(cache=True, _nrt=False, error_model="numpy")
 def normal_absolute_angle(a: float) -> float:
     """Angle in [0, 2pi) (Utils.normalAbsoluteAngle; Java's % on doubles is C fmod)."""
+    if 0.0 <= a < TWO_PI:  # fmod leaves such values unchanged; skip the slow call
+        return a
     a = np.fmod(a, TWO_PI)
     return a if a >= 0.0 else a + TWO_PI
 
@@ -47,6 +49,8 @@ def normal_absolute_angle(a: float) -> float:
 @njit(cache=True, _nrt=False, error_model="numpy")
 def normal_relative_angle(a: float) -> float:
     """Angle in [-pi, pi) (Utils.normalRelativeAngle)."""
+    if -math.pi <= a < math.pi:  # fmod leaves these unchanged and the result is a itself
+        return a
     a = np.fmod(a, TWO_PI)
     if a >= 0.0:
         return a if a < math.pi else a - TWO_PI
@@ -356,6 +360,18 @@ def java_next_double(state: int) -> tuple[int, float]:
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
+def _mod31(u: int, bound: int) -> int:
+    """u % bound for 0 <= u < 2^31 and 0 < bound < 2^31 without an integer division (exact)."""
+    q = int(u * (1.0 / bound))  # off by at most one: 53-bit doubles, 31-bit operands
+    r = u - q * bound
+    if r < 0:
+        r += bound
+    elif r >= bound:
+        r -= bound
+    return r
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
 def java_next_int(state: int, bound: int) -> tuple[int, int]:
     """java.util.Random.nextInt(bound) with its rejection rule."""
     state, r = java_next(state, 31)
@@ -363,8 +379,8 @@ def java_next_int(state: int, bound: int) -> tuple[int, int]:
     if (bound & m) == 0:
         return state, (bound * r) >> 31
     u = r
-    r = u % bound
+    r = _mod31(u, bound)
     while u - r + m >= (1 << 31):  # int overflow in Java makes this negative
         state, u = java_next(state, 31)
-        r = u % bound
+        r = _mod31(u, bound)
     return state, r

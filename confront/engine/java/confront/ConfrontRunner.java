@@ -52,6 +52,7 @@ public final class ConfrontRunner extends BattleAdaptor {
     private final Map<String, Integer> skipped = new LinkedHashMap<>();
     private final List<String> errors = new ArrayList<>();
     private final List<String> messages = new ArrayList<>();
+    private final List<String> reports = new ArrayList<>();
     private ITurnSnapshot last;
     private BattleCompletedEvent completed;
     private RobocodeEngine engine;
@@ -166,11 +167,22 @@ public final class ConfrontRunner extends BattleAdaptor {
                 robotTurns++;
             }
             String out = r.getOutputStreamSnapshot();
+            if (out != null && out.contains("CONFRONT ") && reports.size() < 1000) {
+                for (String line : out.split("\n")) {
+                    if (line.startsWith("CONFRONT ")) {
+                        reports.add(r.getName() + ": " + line.substring(9));
+                    }
+                }
+            }
             if (out != null && out.contains(" skipped turn ")) {
                 int n = 0;
                 for (String line : out.split("\n")) {
                     if (line.startsWith("SYSTEM: ") && line.contains(" skipped turn ")) {
                         n++;
+                        if (reports.size() < 1000) {
+                            reports.add(r.getName() + ": skipped round=" + snap.getRound() + " "
+                                    + line.substring(line.indexOf(" skipped turn ") + 1));
+                        }
                     }
                 }
                 skipped.merge(r.getName(), n, Integer::sum);
@@ -371,6 +383,8 @@ public final class ConfrontRunner extends BattleAdaptor {
         }
         b.append("],\"errors\":[");
         appendStrings(b, errors);
+        b.append("],\"robot_reports\":[");
+        appendStrings(b, reports);
         b.append("],\"messages\":[");
         appendStrings(b, messages);
         b.append("]}\n");

@@ -1,0 +1,66 @@
+"""Battles in the real engine where the project's BridgeBot tanks take their decisions from a Python policy."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, replace
+
+from confront.engine.battle import BattleSpec
+from confront.engine.bridge import BridgeServer, Policy
+from confront.engine.runner import EngineOptions, EngineRun, run_battle
+
+BRIDGE_BOT = "confront.BridgeBot*"
+
+
+def bridge_timeout_ms(cpu_constant_ms: float) -> int:
+    """How long a robot waits for Python before falling back: 20 engine turns of robot time.
+
+    The engine stops a robot after 30 skipped turns in a row [RobotPeer], so a stall must be noticed sooner.
+    """
+    return max(50, int(20 * cpu_constant_ms))
+
+
+def bridge_options(options: EngineOptions, port: int, token: str, timeout_ms: int) -> EngineOptions:
+    """Engine options for a bridged battle: sandbox off (sockets), bridge address in system properties."""
+    if timeout_ms <= 0:
+        raise ValueError(f"timeout_ms must be > 0, got {timeout_ms}")
+    props = (f"-Dconfront.bridge.port={port}", f"-Dconfront.bridge.token={token}",
+             f"-Dconfront.bridge.timeoutMs={timeout_ms}")
+    return replace(options, nosecurity=True, extra_jvm_args=options.extra_jvm_args + props)
+
+
+@dataclass(frozen=True)
+class BridgedRun:
+    """An engine run plus what the bridge saw: decisions served, errors, robots that fell back."""
+
+    run: EngineRun
+    decisions: int
+    connections: int
+    server_errors: tuple[str, ...]
+    failures: tuple[str, ...]
+
+    @property
+    def ok(self) -> bool:
+        """True when no robot fell back to its built-in behaviour."""
+        return not self.failures and not self.server_errors
+
+
+def bridge_failures(run: EngineRun) -> tuple[str, ...]:
+    """The robots' 'bridge-failed' reports collected by the runner."""
+    return tuple(r for r in run.summary.get("robot_reports", []) if "bridge-failed" in r)
+
+
+def run_bridged_battle(
+    spec: BattleSpec,
+    policy: Policy,
+    options: EngineOptions | None = None,
+    timeout_ms: int | None = None,
+    workdir: str | os.PathLike[str] | None = None,
+) -> BridgedRun:
+    """Run ``spec`` (whose contestants include BridgeBot tanks) with ``policy`` deciding for every BridgeBot."""
+    opts = options or EngineOptions()
+    tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)
+    with BridgeServer(policy) as server:
+        run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo), workdir=workdir)
+    return BridgedRun(run=run, decisions=server.stats.decisions, connections=server.stats.connections,
+                      server_errors=tuple(server.stats.errors), failures=bridge_failures(run))

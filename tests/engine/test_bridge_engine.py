@@ -1,0 +1,98 @@
+"""Bridged tanks in the real engine: playing, and surviving a Python side that dies or stalls."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from confront.engine.battle import BattleSpec, scenario_battle
+from confront.engine.bridge import Observation, nearest_enemy_policy
+from confront.engine.bridged import BRIDGE_BOT, bridge_failures, bridge_options, run_bridged_battle
+from confront.engine.runner import EngineOptions, run_battle
+
+pytestmark = pytest.mark.engine
+
+
+def test_bridged_tank_plays_rounds(install) -> None:
+    seen: list[Observation] = []
+
+    def policy(obs: Observation):
+        seen.append(obs)
+        return nearest_enemy_policy(obs)
+
+    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=2), policy)
+    assert res.ok, (res.failures, res.server_errors)
+    assert res.connections == 2  # one connection per round
+    assert res.decisions == len(seen) > 100
+    assert {o.round for o in seen} == {0, 1}
+    for a, b in zip(seen, seen[1:], strict=False):
+        assert (b.round, b.turn) > (a.round, a.turn)  # one decision per turn, in order
+    assert all(18 <= o.x <= 782 and 18 <= o.y <= 582 for o in seen)
+    me = next(r for r in res.run.results.contestants if r.name.startswith("confront.BridgeBot"))
+    assert me.firsts == 2 and me.bullet_dmg > 0  # SittingDuck never shoots back
+
+
+def test_bridged_team_shares_one_policy(install) -> None:
+    names: set[str] = set()
+
+    def policy(obs: Observation):
+        names.add(obs.robot)
+        assert len(obs.teammates) == 3 and obs.robot not in obs.teammates
+        return nearest_enemy_policy(obs)
+
+    spec = scenario_battle("4v4", "confront.BridgeBot", "SittingDuck", rounds=1)
+    spec = BattleSpec(spec.contestants[:1] + ("SittingDuck",), rounds=1)
+    assert spec.robot_count == 5
+    res = run_bridged_battle(spec, policy)
+    assert res.ok, (res.failures, res.server_errors)
+    assert res.connections == 4 and len(names) == 4
+
+
+def test_stalling_python_falls_back(install) -> None:
+    seen: list[tuple[int, int]] = []
+
+    def policy(obs: Observation):
+        seen.append((obs.round, obs.turn))
+        if obs.round == 0 and obs.turn == 40:
+            time.sleep(0.4)  # twice the robot's 200 ms patience
+        return nearest_enemy_policy(obs)
+
+    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=3), policy)
+    round0 = [f for f in res.failures if "round=0" in f]
+    assert len(round0) == 1 and "turn=39" in round0[0] and "SocketTimeoutException" in round0[0]
+    assert max(t for r, t in seen if r == 0) == 40  # no decisions after the stall
+    assert any(r == 2 for r, _ in seen)  # a later round reconnects and plays bridged again
+    assert res.run.results.rounds == 3
+
+
+def test_python_killed_mid_battle(install) -> None:
+    server = subprocess.Popen(
+        [sys.executable, "-m", "confront.engine.bridge", "0", "secret"], stdout=subprocess.PIPE, text=True,
+    )
+    try:
+        port = int(server.stdout.readline().split()[1])  # "ready PORT"
+
+        def kill_in_round_1() -> None:
+            for line in server.stdout:
+                if line.startswith("hello") and line.split()[-1] == "1":
+                    time.sleep(0.2)
+                    server.kill()
+                    return
+
+        killer = threading.Thread(target=kill_in_round_1, daemon=True)
+        killer.start()
+        opts = bridge_options(EngineOptions(seed=3), port, "secret", 200)
+        run = run_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=3), opts)
+        killer.join(timeout=5)
+    finally:
+        server.kill()
+        server.wait()
+    assert server.returncode == -9
+    failures = bridge_failures(run)
+    assert any("round=1" in f for f in failures)  # lost mid-round
+    assert any("round=2" in f and "connect" in f for f in failures)  # nobody listening any more
+    assert run.results.rounds == 3 and len(run.round_turns) == 3

@@ -1,0 +1,111 @@
+"""Bridge protocol v1: message validation and a real loopback round trip (no engine needed)."""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+
+import pytest
+
+from confront.engine.bridge import (
+    BridgeServer,
+    Observation,
+    format_action,
+    load_policy,
+    nearest_enemy_policy,
+    parse_hello,
+    parse_observation,
+)
+
+HELLO = {"v": 1, "type": "hello", "token": "t0k", "name": "confront.BridgeBot* (1)",
+         "team": "confront.BridgeBot* (2)", "round": 0, "rounds": 3, "width": 800.0, "height": 600.0}
+OBS = {"v": 1, "type": "obs", "round": 0, "turn": 7, "x": 100.0, "y": 200.0, "heading": 0.0,
+       "gun_heading": 0.5, "radar_heading": 1.0, "velocity": 8.0, "energy": 99.5, "gun_heat": 2.3,
+       "others": 2, "distance_remaining": 12.0,
+       "scans": [{"name": "sample.Walls", "time": 6, "teammate": False, "bearing": 0.5, "distance": 300.0,
+                  "heading": 1.0, "velocity": -8.0, "energy": 80.0, "x": 400.0, "y": 200.0},
+                 {"name": "confront.BridgeBot* (2)", "time": 5, "teammate": True, "bearing": 0.1,
+                  "distance": 50.0, "heading": 2.0, "velocity": 0.0, "energy": 100.0, "x": 105.0, "y": 250.0}],
+       "events": [{"type": "hit_wall"}]}
+
+
+def test_parse_observation_values() -> None:
+    obs = parse_observation(json.dumps(OBS), parse_hello(json.dumps(HELLO), "t0k"))
+    assert (obs.robot, obs.teammates, obs.turn, obs.others) == ("confront.BridgeBot* (1)",
+                                                                ("confront.BridgeBot* (2)",), 7, 2)
+    assert (obs.x, obs.y, obs.energy, obs.gun_heat, obs.width) == (100.0, 200.0, 99.5, 2.3, 800.0)
+    assert [s.name for s in obs.enemies()] == ["sample.Walls"]
+    assert obs.events == ({"type": "hit_wall"},)
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [({"v": 2}, "version"), ({"type": "hello"}, "obs"), ({"x": "1"}, "'x'"), ({"turn": 1.5}, "'turn'"),
+     ({"energy": float("nan")}, "'energy'"), ({"scans": {}}, "scans"), ({"scans": [{"name": 3}]}, "scan")],
+)
+def test_bad_observations_rejected(change: dict, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        parse_observation(json.dumps({**OBS, **change}), HELLO)
+
+
+def test_bad_hello_rejected() -> None:
+    with pytest.raises(ValueError, match="token"):
+        parse_hello(json.dumps(HELLO), "other")
+    with pytest.raises(ValueError, match="version"):
+        parse_hello(json.dumps({**HELLO, "v": 0}), "t0k")
+
+
+def test_format_action() -> None:
+    assert format_action(7, (10.0, math.nan, -0.25, 1, 0)) == "A 7 10.0 NaN -0.25 1.0 0.0\n"
+    with pytest.raises(ValueError, match="5 values"):
+        format_action(1, (1.0, 2.0))
+    with pytest.raises(ValueError, match="fire"):
+        format_action(1, (0, 0, 0, 0, 3.5))
+    with pytest.raises(ValueError, match="finite"):
+        format_action(1, (math.inf, 0, 0, 0, 0))
+
+
+def test_reference_policy_aims_at_nearest_enemy() -> None:
+    obs = parse_observation(json.dumps({**OBS, "gun_heat": 0.0}), HELLO)
+    ahead, body, gun, radar, fire = nearest_enemy_policy(obs)
+    # enemy due east (bearing pi/2), gun at 0.5 rad: turn gun by pi/2 - 0.5
+    assert gun == pytest.approx(math.pi / 2 - 0.5)
+    assert body == pytest.approx(-math.pi)  # perpendicular to the enemy: absolute pi/2 + pi/2, wrapped
+    assert fire == 0.0  # not aligned yet
+    assert load_policy("confront.engine.bridge:nearest_enemy_policy") is nearest_enemy_policy
+    with pytest.raises(ValueError, match="module:function"):
+        load_policy("nocolon")
+
+
+def _lines(sock: socket.socket, n: int) -> list[str]:
+    buf = b""
+    while buf.count(b"\n") < n:
+        chunk = sock.recv(4096)
+        if not chunk:
+            break
+        buf += chunk
+    return buf.decode().splitlines()
+
+
+def test_server_round_trip_on_loopback() -> None:
+    seen: list[Observation] = []
+
+    def policy(obs: Observation) -> tuple[float, ...]:
+        seen.append(obs)
+        return (obs.turn * 1.0, math.nan, 0.0, 0.0, 1.5)
+
+    with BridgeServer(policy, token="t0k") as server:
+        assert server.port > 0
+        with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
+            s.sendall((json.dumps(HELLO) + "\n").encode())
+            assert _lines(s, 1) == ["OK 1"]
+            s.sendall((json.dumps(OBS) + "\n" + json.dumps({**OBS, "turn": 8}) + "\n").encode())
+            assert _lines(s, 2) == ["A 7 7.0 NaN 0.0 0.0 1.5", "A 8 8.0 NaN 0.0 0.0 1.5"]
+            s.sendall(b'{"v":1,"type":"end","round":0,"turn":9,"how":"death","energy":0}\n')
+        with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
+            s.sendall((json.dumps({**HELLO, "token": "bad"}) + "\n").encode())
+            assert _lines(s, 1) == []  # closed without an answer
+    assert [o.turn for o in seen] == [7, 8]
+    assert server.stats.decisions == 2 and server.stats.connections == 2
+    assert len(server.stats.errors) == 1 and "token" in server.stats.errors[0]

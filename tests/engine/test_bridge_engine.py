@@ -79,8 +79,7 @@ def test_python_killed_mid_battle(install) -> None:
         def kill_in_round_1() -> None:
             for line in server.stdout:
                 if line.startswith("hello") and line.split()[-1] == "1":
-                    time.sleep(0.2)
-                    server.kill()
+                    server.kill()  # dies while greeting the robot in round 1
                     return
 
         killer = threading.Thread(target=kill_in_round_1, daemon=True)
@@ -93,6 +92,6 @@ def test_python_killed_mid_battle(install) -> None:
         server.wait()
     assert server.returncode == -9
     failures = bridge_failures(run)
-    assert any("round=1" in f for f in failures)  # lost mid-round
+    assert any("round=1" in f for f in failures)  # lost during round 1
     assert any("round=2" in f and "connect" in f for f in failures)  # nobody listening any more
     assert run.results.rounds == 3 and len(run.round_turns) == 3

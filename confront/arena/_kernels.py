@@ -65,6 +65,7 @@ S_SURV, S_LAST, S_BDMG, S_BKILL, S_RAM, S_RKILL = range(6)
 B_NONE, B_FIRED, B_MOVING, B_HIT_VICTIM, B_HIT_BULLET, B_HIT_WALL, B_EXPLODED = range(7)
 BULLET_EXPLOSION = 17  # BulletPeer.EXPLOSION_LENGTH
 ROBOT_EXPLOSION = 71  # ExplosionPeer.EXPLOSION_LENGTH
+HALT_TURNS = 120  # robots halted when endTimer > 4 * TURNS_DISPLAYED_AFTER_ENDING (Battle.shutdownTurn)
 
 # params vector
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
@@ -198,7 +199,7 @@ def _remove_from_list(ki, bi, b, pos):
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params):
+def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params, bb_decided):
     """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
     mode = int(params[P_ORDER])
     n = rf.shape[2]
@@ -235,7 +236,8 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
                 or y + BULLET_RADIUS >= params[P_H]:
             st = B_HIT_WALL
             ki[b, KFRAME, s] = 0
-            ri[b, EVMISSED, owner] += 1
+            if rb[b, ALIVE, owner] or rb[b, EVDIED, owner]:
+                ri[b, EVMISSED, owner] += 1
         if st == B_FIRED or st == B_MOVING:
             cand = 0
             for j in range(n):
@@ -265,11 +267,15 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
                     _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, j)
                     if not team_fire:
                         score[b, owner, S_BKILL] += 0.2 * _team_ledger(ri, ledger, b, owner, j)
-                # 3p back to the shooter, even if it died this turn (Rules.getBulletHitBonus)
-                _set_energy(rf, bi, bf, b, owner, rf[b, E, owner] + bullet_hit_bonus(p), True)
+                # 3p back to the shooter (Rules.getBulletHitBonus), even if it died this turn; a robot dead
+                # since an earlier turn has stopped (RobotPeer.updateEnergy: isExecFinishedAndDisabled)
+                if (rb[b, ALIVE, owner] or rb[b, EVDIED, owner]) and \
+                        not (bb_decided and bi[b, ENDT] >= HALT_TURNS + 2):
+                    _set_energy(rf, bi, bf, b, owner, rf[b, E, owner] + bullet_hit_bonus(p), True)
                 ri[b, EVHITBY, j] += 1
                 rf[b, EVBULB, j] = normal_relative_angle(kf[b, KH, s] + math.pi - rf[b, H, j])
-                ri[b, EVBHIT, owner] += 1
+                if rb[b, ALIVE, owner] or rb[b, EVDIED, owner]:  # a stopped robot gets no events
+                    ri[b, EVBHIT, owner] += 1
                 if box_contains(rf[b, BX, j], rf[b, BY, j], lx, ly):
                     kf[b, KX, s] = lx
                     kf[b, KY, s] = ly
@@ -580,9 +586,13 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
         for j in range(n):
             scanned[b, i, j] = False
     dead[n] = 0
+    # robots are halted 120 turns after the decision (BaseBattle): the commands sent while being halted
+    # are the last ones taken, and from then on a robot gains no energy (isExecFinishedAndDisabled)
+    accept = not bb[b, DECIDED] or bi[b, ENDT] <= HALT_TURNS + 2
+    accept_energy = not bb[b, DECIDED] or bi[b, ENDT] < HALT_TURNS + 2
     # 1. load commands (robot list order); a disabled robot cannot set move or body turn
     for i in range(n):
-        if not rb[b, ALIVE, i]:
+        if not rb[b, ALIVE, i] or not accept:
             continue
         c = cmd[b, i, 0]
         if not math.isnan(c) and rf[b, E, i] > 0.0:
@@ -615,7 +625,8 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
         order[q] = ki[b, KLIST, perm_d[q]]
     for q in range(nb):
         s = order[q]
-        _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params)
+        _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params,
+                       bb[b, DECIDED])
         if ki[b, KSTATE, s] == B_NONE:
             for p in range(bi[b, NB]):
                 if ki[b, KLIST, p] == s:
@@ -710,6 +721,17 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bi[b, INACT] += 1
     if bi[b, TIME] >= params[P_MAXT] and not bb[b, DONE]:
         bb[b, DONE] = True
+    if not accept_energy:  # halted robots have stopped: they are told nothing
+        for i in range(n):
+            rb[b, EVWALL, i] = False
+            rb[b, EVFAULT, i] = False
+            rb[b, EVDIED, i] = False
+            ri[b, EVROBOT, i] = -1
+            ri[b, EVHITBY, i] = 0
+            ri[b, EVBHIT, i] = 0
+            ri[b, EVMISSED, i] = 0
+            for j in range(n):
+                scanned[b, i, j] = False
     # 6. robots woken in random order
     bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
 

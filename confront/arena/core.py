@@ -63,7 +63,7 @@ import math
 import numpy as np
 
 from . import _kernels as K
-from .rules import java_seed
+from .rules import java_next_double, java_seed
 from .scenarios import Scenario, get_scenario
 from .state import FIELDS, ArenaState, allocate
 
@@ -109,8 +109,19 @@ class Arena:
         return self.state.n_robots
 
     def seed(self, seed: int) -> None:
-        """Seed every battle's java.util.Random with ``seed + b``."""
+        """Seed every battle's java.util.Random with ``seed + b`` and start the battles."""
         self.state.rng[:] = [java_seed(int(seed) + b) for b in range(self.n_battles)]
+        self._battle_start(np.arange(self.n_battles))
+
+    def _battle_start(self, idx: np.ndarray) -> None:
+        """The engine draws 3 doubles per entry of a fixed initial-positions string (Battle.computeInitialPositions)."""
+        if not self._has_fixed:
+            return
+        for b in idx:
+            r = int(self.state.rng[b])
+            for _ in range(3 * self.n_robots):
+                r, _d = java_next_double(r)
+            self.state.rng[b] = r
 
     def _mask(self, mask: np.ndarray | None) -> np.ndarray:
         if mask is None:
@@ -135,6 +146,7 @@ class Arena:
         s = self.state
         for name in ("score_total", "placements_total", "round", "inactivity_energy"):
             s.arrays[name][idx] = 0
+        self._battle_start(idx)
         self.reset(mask)
 
     def step(self, commands: np.ndarray) -> None:

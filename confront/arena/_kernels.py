@@ -52,7 +52,7 @@ from .state import BB_FIELDS, BF_FIELDS, BI_FIELDS, KF_FIELDS, KI_FIELDS, RB_FIE
 X, Y, H, GH, RH, V, E, HEAT, BX, BY, DIST, BODYREM, GUNREM, RADREM, MAXV, MAXTURN, ASSIST, \
     EVWALLB, EVROBB, EVBULB = range(len(RF_FIELDS))
 ALIVE, OVERDRIVE, INCOLL, TRWG, WINNER, ADV, LEADER, DROID, ADJGB, ADJRB, ADJRG, \
-    EVWALL, EVFAULT, EVFIRED, EVDIED = range(len(RB_FIELDS))
+    EVWALL, EVFAULT, EVFIRED, EVDIED, SCANREQ = range(len(RB_FIELDS))
 TEAM, EVROBOT, EVHITBY, EVBHIT, EVMISSED = range(len(RI_FIELDS))
 RNG, TIME, ROUND, INACT, ENDT, NB = range(len(BI_FIELDS))
 (INACT_E,) = range(len(BF_FIELDS))
@@ -513,8 +513,8 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             ri[b, EVROBOT, j] = i
             rf[b, EVROBB, j] = normal_relative_angle(math.pi + angle - rf[b, H, j])
     # the radar scans this turn if anything moved or turned
-    last[b, 2, i] = 1.0 if (lh != rf[b, H, i] or lg != rf[b, GH, i] or lr != rf[b, RH, i]
-                            or lx != rf[b, X, i] or ly != rf[b, Y, i]) else 0.0
+    if lh != rf[b, H, i] or lg != rf[b, GH, i] or lr != rf[b, RH, i] or lx != rf[b, X, i] or ly != rf[b, Y, i]:
+        last[b, 2, i] = 1.0
     if zap != 0.0:  # inactivity drain (RobotPeer.zap)
         if rf[b, E, i] == 0.0:
             _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i)
@@ -592,8 +592,12 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     accept_energy = not bb[b, DECIDED] or bi[b, ENDT] < HALT_TURNS + 2
     # 1. load commands (robot list order); a disabled robot cannot set move or body turn
     for i in range(n):
+        last[b, 2, i] = 0.0
         if not rb[b, ALIVE, i] or not accept:
             continue
+        if rb[b, SCANREQ, i]:  # scan() was called: the radar scans this turn even if nothing moves
+            last[b, 2, i] = 1.0
+            rb[b, SCANREQ, i] = False
         c = cmd[b, i, 0]
         if not math.isnan(c) and rf[b, E, i] > 0.0:
             rf[b, DIST, i] = c

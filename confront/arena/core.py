@@ -26,7 +26,8 @@ Per robot ``(B, R)``: ``x``, ``y`` (centre; y up), ``heading``, ``gun_heading``,
 ``alive`` (false once dead; a disabled robot is alive with energy 0), remaining command values
 ``distance_remaining``, ``body_turn_remaining``, ``gun_turn_remaining``, ``radar_turn_remaining``,
 settings ``max_velocity``, ``max_turn_rate``, ``fire_assist`` (angle for a plain Robot's assisted
-shot this turn, NaN = none; consumed at load), flags ``team`` (int), ``is_advanced`` (wall damage),
+shot this turn, NaN = none; consumed at load), ``scan_request`` (a ``scan()`` call: the radar scans
+this turn even if nothing moved; consumed at load), flags ``team`` (int), ``is_advanced`` (wall damage),
 ``is_leader`` (200 energy, its death costs team-mates 30), ``is_droid`` (120 energy, no radar),
 ``adjust_gun_for_body``, ``adjust_radar_for_body``, ``adjust_radar_for_gun``; internal
 ``overdriving``, ``in_collision`` (at fault last turn: no body turn), ``turned_radar_with_gun``,

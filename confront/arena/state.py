@@ -32,7 +32,7 @@ RF_FIELDS = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "e
              "ev_hit_wall_bearing", "ev_hit_robot_bearing", "ev_hit_by_bullet_bearing")
 RB_FIELDS = ("alive", "overdriving", "in_collision", "turned_radar_with_gun", "winner", "is_advanced",
              "is_leader", "is_droid", "adjust_gun_for_body", "adjust_radar_for_body", "adjust_radar_for_gun",
-             "ev_hit_wall", "ev_at_fault", "ev_fired", "ev_died")
+             "ev_hit_wall", "ev_at_fault", "ev_fired", "ev_died", "scan_request")
 RI_FIELDS = ("team", "ev_hit_robot", "ev_hit_by_bullet", "ev_bullet_hit", "ev_bullet_missed")
 BI_FIELDS = ("rng", "time", "round", "inactive_turns", "end_timer", "n_bullets")
 BF_FIELDS = ("inactivity_energy",)

@@ -1,0 +1,518 @@
+"""Scripted robots that behave like Robocode's sample robots, compiled and batched.
+
+SittingDuck, SpinBot, Walls, Tracker, RamFire, Fire, Corners and Crazy, written from their observable
+behaviour (main loop of blocking calls, event handlers). A plain ``Robot`` blocks on every call; here
+each robot has a small state machine in a per-robot memory row:
+
+- a *main* queue of operations (the current pass of ``run()``'s loop) and a *handler* queue (the
+  event handler running, with its priority); a handler interrupts the main queue, which then
+  resumes its current operation - finished if the handler's own moves used up the remaining value,
+  exactly as a blocking call in ``run()`` re-checks ``getDistanceRemaining()`` after a handler.
+- operations: blocking move / body / gun / radar turns (done when the remaining value is 0, after
+  at least one turn), ``fire`` / ``scan`` / ``stop`` / ``resume`` (one turn each), setters that do
+  not block (``setAhead``, ``setTurnRight``, ``setMaxVelocity``) and ``waitFor(turn complete)``.
+- events (Robocode priorities): scanned robot 10, hit by bullet 20, hit wall 30, hit robot 40. A
+  handler starts when nothing of equal or higher priority runs; ``scan()`` at the end of an
+  ``onScannedRobot`` restarts it when a robot is seen again (Robocode's interrupted handler).
+  Scanned data are the true end-of-turn values of the scanned robot (what the event carries).
+  With several robots scanned in one turn the nearest is taken (Tracker: its tracked robot).
+- a plain Robot's ``fire`` inside ``onScannedRobot`` uses Robocode's fire assist (the bullet heads
+  at the scanned robot when the gun and radar turned together).
+
+Usage: ``bots = ScriptedBots(arena, ["SpinBot", None, ...])`` (a name per robot, None = driven by
+someone else), then every turn ``bots.commands(cmd)`` fills those robots' rows of ``cmd``; call
+``bots.reset(mask)`` after ``arena.reset(mask)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .core import Arena
+from .rules import normal_absolute_angle, normal_relative_angle
+
+__all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind"]
+
+BOT_NAMES = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy")
+ADVANCED_BOTS = frozenset({"SittingDuck", "SpinBot", "Crazy"})  # the others are plain Robots
+K_NONE, K_DUCK, K_SPIN, K_WALLS, K_TRACKER, K_RAMFIRE, K_FIRE, K_CORNERS, K_CRAZY = range(9)
+
+# operation codes
+O_MOVE, O_TURN, O_GUN, O_RADAR, O_FIRE, O_SCAN, O_STOP, O_RESUME, O_SETMAXV, O_SETMOVE, O_SETTURN, \
+    O_WAITTURN, O_FIREASSIST = range(1, 14)
+Q = 8  # operations per queue
+# memory layout
+M_HPRIO, M_HLEN, M_HPOS, M_HSTART, M_MLEN, M_MPOS, M_MSTART, M_PHASE = range(8)
+M_VAR = 8  # 8 bot variables
+M_SAVE = 16  # stop(): saved distance, body, gun, radar remaining
+M_TARGET = 20  # scanned target of the running handler (fire assist)
+M_HOPS = 24
+M_MOPS = M_HOPS + 2 * Q
+M_STATIC = M_MOPS + 2 * Q  # kept across rounds (Corners' corner)
+M_SIZE = M_STATIC + 2
+
+P_SCAN, P_BULLET, P_WALL, P_ROBOT = 10.0, 20.0, 30.0, 40.0
+DEG = math.pi / 180.0
+
+
+def bot_kind(name: str | None) -> int:
+    """Kind code of a bot name (0 for None)."""
+    if name is None:
+        return K_NONE
+    if name not in BOT_NAMES:
+        raise ValueError(f"unknown bot {name!r}; known: {', '.join(BOT_NAMES)}")
+    return BOT_NAMES.index(name) + 1
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _push(mem, b, i, base, lenpos, op, val):
+    """Append an operation to a queue (base = M_HOPS or M_MOPS, lenpos = M_HLEN or M_MLEN)."""
+    n = int(mem[b, i, lenpos])
+    if n < Q:
+        mem[b, i, base + 2 * n] = op
+        mem[b, i, base + 2 * n + 1] = val
+        mem[b, i, lenpos] = n + 1
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _start_handler(mem, b, i, prio):
+    mem[b, i, M_HPRIO] = prio
+    mem[b, i, M_HLEN] = 0
+    mem[b, i, M_HPOS] = 0
+    mem[b, i, M_HSTART] = 0
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _h(mem, b, i, op, val):
+    _push(mem, b, i, M_HOPS, M_HLEN, op, val)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _m(mem, b, i, op, val):
+    _push(mem, b, i, M_MOPS, M_MLEN, op, val)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _refill_main(kind, mem, b, i, heading, width, height, others):
+    """Next pass of run(): the set-up part once per round, then the loop body."""
+    mem[b, i, M_MLEN] = 0
+    mem[b, i, M_MPOS] = 0
+    mem[b, i, M_MSTART] = 0
+    first = mem[b, i, M_PHASE] == 0
+    mem[b, i, M_PHASE] = 1
+    if kind == K_SPIN:
+        _m(mem, b, i, O_SETTURN, 10000 * DEG)
+        _m(mem, b, i, O_SETMAXV, 5.0)
+        _m(mem, b, i, O_MOVE, 10000.0)
+    elif kind == K_WALLS:
+        amount = max(width, height)
+        if first:
+            mem[b, i, M_VAR] = 0.0  # peek
+            _m(mem, b, i, O_TURN, -np.fmod(heading, math.pi / 2))  # turnLeft(heading % 90)
+            _m(mem, b, i, O_MOVE, amount)
+            _m(mem, b, i, O_SETMAXV, -1.0)  # marker: peek = true
+            _m(mem, b, i, O_GUN, 90 * DEG)
+            _m(mem, b, i, O_TURN, 90 * DEG)
+        else:
+            _m(mem, b, i, O_SETMAXV, -1.0)  # peek = true
+            _m(mem, b, i, O_MOVE, amount)
+            _m(mem, b, i, O_SETMAXV, -2.0)  # peek = false
+            _m(mem, b, i, O_TURN, 90 * DEG)
+    elif kind == K_TRACKER:
+        if first:
+            mem[b, i, M_VAR] = 0.0  # count
+            mem[b, i, M_VAR + 1] = 10.0  # gunTurnAmt (deg)
+            mem[b, i, M_VAR + 2] = -1.0  # tracked robot
+        _m(mem, b, i, O_GUN, mem[b, i, M_VAR + 1] * DEG)
+        _m(mem, b, i, O_SETMAXV, -3.0)  # marker: count bookkeeping after the turn
+    elif kind == K_RAMFIRE:
+        if first:
+            mem[b, i, M_VAR] = 1.0  # turnDirection
+        _m(mem, b, i, O_TURN, 5 * DEG * mem[b, i, M_VAR])
+    elif kind == K_FIRE:
+        if first:
+            mem[b, i, M_VAR] = 50.0  # dist
+        _m(mem, b, i, O_GUN, 5 * DEG)
+    elif kind == K_CORNERS:
+        if first:
+            mem[b, i, M_VAR] = 0.0  # stopWhenSeeRobot
+            mem[b, i, M_VAR + 1] = 3.0  # gunIncrement
+            mem[b, i, M_VAR + 2] = others
+            corner = mem[b, i, M_STATIC]
+            _m(mem, b, i, O_TURN, normal_relative_angle(corner * DEG - heading))
+            _m(mem, b, i, O_SETMAXV, -4.0)  # stopWhenSeeRobot = true
+            _m(mem, b, i, O_MOVE, 5000.0)
+            _m(mem, b, i, O_TURN, -90 * DEG)
+            _m(mem, b, i, O_MOVE, 5000.0)
+            _m(mem, b, i, O_GUN, -90 * DEG)
+        else:
+            # 30 x turnGunLeft(gunIncrement) as one gun op of 90 deg would differ in scan timing only
+            # slightly; keep the 3-degree steps through a counter
+            _m(mem, b, i, O_GUN, -mem[b, i, M_VAR + 1] * DEG)
+            _m(mem, b, i, O_SETMAXV, -5.0)  # marker: count the step, flip after 30
+    elif kind == K_CRAZY:
+        _m(mem, b, i, O_SETMOVE, 40000.0)
+        _m(mem, b, i, O_SETMAXV, -6.0)  # movingForward = true
+        _m(mem, b, i, O_SETTURN, 90 * DEG)
+        _m(mem, b, i, O_WAITTURN, 0.0)
+        _m(mem, b, i, O_SETTURN, -180 * DEG)
+        _m(mem, b, i, O_WAITTURN, 0.0)
+        _m(mem, b, i, O_SETTURN, 180 * DEG)
+        _m(mem, b, i, O_WAITTURN, 0.0)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _marker(kind, mem, b, i, code):
+    """Bookkeeping steps of run() written as pseudo-operations (negative SETMAXV values)."""
+    if code == -1.0:
+        mem[b, i, M_VAR] = 1.0
+    elif code == -2.0:
+        mem[b, i, M_VAR] = 0.0
+    elif code == -3.0:  # Tracker's count
+        c = mem[b, i, M_VAR] + 1
+        mem[b, i, M_VAR] = c
+        if c > 2:
+            mem[b, i, M_VAR + 1] = -10.0
+        if c > 5:
+            mem[b, i, M_VAR + 1] = 10.0
+        if c > 11:
+            mem[b, i, M_VAR + 2] = -1.0
+    elif code == -4.0:
+        mem[b, i, M_VAR] = 1.0
+    elif code == -5.0:  # Corners: flip the gun direction every 30 steps
+        mem[b, i, M_VAR + 3] += 1
+        if mem[b, i, M_VAR + 3] >= 30:
+            mem[b, i, M_VAR + 3] = 0
+            mem[b, i, M_VAR + 1] *= -1
+    elif code == -6.0:
+        mem[b, i, M_VAR + 4] = 1.0  # Crazy movingForward
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _reverse(mem, b, i, cmd):
+    """Crazy.reverseDirection: setBack/setAhead(40000)."""
+    if mem[b, i, M_VAR + 4] == 1.0:
+        cmd[b, i, 0] = -40000.0
+        mem[b, i, M_VAR + 4] = 0.0
+    else:
+        cmd[b, i, 0] = 40000.0
+        mem[b, i, M_VAR + 4] = 1.0
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
+    """A started operation is finished (blocking ops: remaining value 0)."""
+    if not started:
+        return False
+    if op == O_MOVE:
+        return rem_d == 0.0
+    if op == O_TURN:
+        return rem_b == 0.0
+    if op == O_GUN:
+        return rem_g == 0.0
+    if op == O_RADAR:
+        return rem_r == 0.0
+    if op == O_WAITTURN:
+        return rem_b == 0.0
+    return True
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, rem):
+    """Write an operation's commands; True if it takes the turn (blocking)."""
+    if op == O_MOVE:
+        cmd[b, i, 0] = val
+        return True
+    if op == O_TURN:
+        cmd[b, i, 1] = val
+        return True
+    if op == O_GUN:
+        cmd[b, i, 2] = val
+        return True
+    if op == O_RADAR:
+        cmd[b, i, 3] = val
+        return True
+    if op == O_FIRE or op == O_FIREASSIST:
+        cmd[b, i, 4] = val
+        if op == O_FIREASSIST:
+            assist[b, i] = normal_absolute_angle(math.atan2(tx - x, ty - y))
+        return True
+    if op == O_SCAN:
+        scan_req[b, i] = True
+        return True
+    if op == O_STOP:
+        for k in range(4):
+            mem[b, i, M_SAVE + k] = rem[k]
+            cmd[b, i, k] = 0.0
+        return True
+    if op == O_RESUME:
+        for k in range(4):
+            cmd[b, i, k] = mem[b, i, M_SAVE + k]
+        return True
+    if op == O_SETMAXV:
+        if val >= 0.0:
+            maxv[b, i] = val
+        else:
+            _marker(kind, mem, b, i, val)
+        return False
+    if op == O_SETMOVE:
+        cmd[b, i, 0] = val
+        return False
+    if op == O_SETTURN:
+        cmd[b, i, 1] = val
+        return False
+    if op == O_WAITTURN:
+        return True
+    return False
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing,
+            ev_fault, ev_hitby, ev_hitby_bearing, cmd):
+    """Start the event handler of the highest-priority event of the last turn (if it may run)."""
+    n = x.shape[1]
+    prio = mem[b, i, M_HPRIO]
+    in_scan_at_scan = prio == P_SCAN and int(mem[b, i, M_HPOS]) < int(mem[b, i, M_HLEN]) and \
+        mem[b, i, M_HOPS + 2 * int(mem[b, i, M_HPOS])] == O_SCAN and mem[b, i, M_HSTART] == 1
+    # hit robot (40)
+    j = ev_robot[b, i]
+    if j >= 0 and prio < P_ROBOT:
+        bearing = ev_robot_bearing[b, i]
+        if kind == K_SPIN:
+            _start_handler(mem, b, i, P_ROBOT)
+            if -10 * DEG < bearing < 10 * DEG:
+                _h(mem, b, i, O_FIRE, 3.0)
+            if ev_fault[b, i]:
+                _h(mem, b, i, O_TURN, 10 * DEG)
+            return
+        if kind == K_WALLS:
+            _start_handler(mem, b, i, P_ROBOT)
+            _h(mem, b, i, O_MOVE, -100.0 if -math.pi / 2 < bearing < math.pi / 2 else 100.0)
+            return
+        if kind == K_TRACKER:
+            mem[b, i, M_VAR + 2] = j
+            _start_handler(mem, b, i, P_ROBOT)
+            amt = normal_relative_angle(bearing + h[b, i] - rh[b, i])
+            mem[b, i, M_VAR + 1] = amt / DEG
+            _h(mem, b, i, O_GUN, amt)
+            _h(mem, b, i, O_FIRE, 3.0)
+            _h(mem, b, i, O_MOVE, -50.0)
+            return
+        if kind == K_RAMFIRE:
+            mem[b, i, M_VAR] = 1.0 if bearing >= 0 else -1.0
+            _start_handler(mem, b, i, P_ROBOT)
+            _h(mem, b, i, O_TURN, bearing)
+            e = energy[b, j]
+            if e > 16:
+                _h(mem, b, i, O_FIRE, 3.0)
+            elif e > 10:
+                _h(mem, b, i, O_FIRE, 2.0)
+            elif e > 4:
+                _h(mem, b, i, O_FIRE, 1.0)
+            elif e > 2:
+                _h(mem, b, i, O_FIRE, 0.5)
+            elif e > 0.4:
+                _h(mem, b, i, O_FIRE, 0.1)
+            _h(mem, b, i, O_MOVE, 40.0)
+            return
+        if kind == K_FIRE:
+            _start_handler(mem, b, i, P_ROBOT)
+            _h(mem, b, i, O_GUN, normal_relative_angle(bearing + h[b, i] - gh[b, i]))
+            _h(mem, b, i, O_FIRE, 3.0)
+            return
+        if kind == K_CRAZY:
+            if ev_fault[b, i]:
+                _reverse(mem, b, i, cmd)
+    # hit wall (30): Crazy reverses (no blocking call)
+    if ev_wall[b, i] and kind == K_CRAZY and prio < P_WALL:
+        _reverse(mem, b, i, cmd)
+    # hit by bullet (20): Fire turns perpendicular and moves
+    if ev_hitby[b, i] > 0 and kind == K_FIRE and prio < P_BULLET:
+        bullet_heading = ev_hitby_bearing[b, i] + h[b, i] - math.pi
+        _start_handler(mem, b, i, P_BULLET)
+        _h(mem, b, i, O_TURN, normal_relative_angle(math.pi / 2 - (h[b, i] - bullet_heading)))
+        _h(mem, b, i, O_MOVE, mem[b, i, M_VAR])
+        mem[b, i, M_VAR] *= -1
+        _h(mem, b, i, O_SCAN, 0.0)
+        return
+    # scanned robot (10)
+    if prio < P_SCAN or in_scan_at_scan:
+        best = -1
+        bd = 1e18
+        track = int(mem[b, i, M_VAR + 2]) if kind == K_TRACKER else -1
+        for j2 in range(n):
+            if scanned[b, i, j2] and alive[b, j2]:
+                d = math.hypot(x[b, j2] - x[b, i], y[b, j2] - y[b, i])
+                if track >= 0 and j2 == track:
+                    best = j2
+                    break
+                if d < bd:
+                    bd = d
+                    best = j2
+        if best < 0:
+            return
+        if kind == K_TRACKER and track >= 0 and best != track:
+            return
+        j = best
+        dx = x[b, j] - x[b, i]
+        dy = y[b, j] - y[b, i]
+        dist = math.hypot(dx, dy)
+        bearing = normal_relative_angle(math.atan2(dx, dy) - h[b, i])
+        mem[b, i, M_TARGET] = j
+        if kind == K_SPIN or kind == K_CRAZY:
+            _start_handler(mem, b, i, P_SCAN)
+            _h(mem, b, i, O_FIRE, 3.0 if kind == K_SPIN else 1.0)
+        elif kind == K_WALLS:
+            _start_handler(mem, b, i, P_SCAN)
+            _h(mem, b, i, O_FIREASSIST, 2.0)
+            if mem[b, i, M_VAR] == 1.0:
+                _h(mem, b, i, O_SCAN, 0.0)
+        elif kind == K_TRACKER:
+            mem[b, i, M_VAR + 2] = j
+            mem[b, i, M_VAR] = 0.0
+            amt = normal_relative_angle(bearing + h[b, i] - rh[b, i])
+            mem[b, i, M_VAR + 1] = amt / DEG
+            _start_handler(mem, b, i, P_SCAN)
+            _h(mem, b, i, O_GUN, amt)
+            if dist > 150:
+                _h(mem, b, i, O_TURN, bearing)
+                _h(mem, b, i, O_MOVE, dist - 140)
+            else:
+                _h(mem, b, i, O_FIREASSIST, 3.0)
+                if dist < 100:
+                    _h(mem, b, i, O_MOVE, -40.0 if -math.pi / 2 < bearing <= math.pi / 2 else 40.0)
+                _h(mem, b, i, O_SCAN, 0.0)
+        elif kind == K_RAMFIRE:
+            mem[b, i, M_VAR] = 1.0 if bearing >= 0 else -1.0
+            _start_handler(mem, b, i, P_SCAN)
+            _h(mem, b, i, O_TURN, bearing)
+            _h(mem, b, i, O_MOVE, dist + 5)
+            _h(mem, b, i, O_SCAN, 0.0)
+        elif kind == K_FIRE:
+            _start_handler(mem, b, i, P_SCAN)
+            _h(mem, b, i, O_FIREASSIST, 3.0 if dist < 50 and energy[b, i] > 50 else 1.0)
+            _h(mem, b, i, O_SCAN, 0.0)
+        elif kind == K_CORNERS:
+            p = 1.0 if (dist > 200 or energy[b, i] < 15) else (2.0 if dist > 50 else 3.0)
+            _start_handler(mem, b, i, P_SCAN)
+            if mem[b, i, M_VAR] == 1.0:
+                _h(mem, b, i, O_STOP, 0.0)
+                _h(mem, b, i, O_FIREASSIST, p)
+                _h(mem, b, i, O_SCAN, 0.0)
+                _h(mem, b, i, O_RESUME, 0.0)
+            else:
+                _h(mem, b, i, O_FIREASSIST, p)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
+              assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
+              ev_hitby_bearing, ev_died, width, height, cmd, rem):
+    """One decision of every scripted robot (its robot time between two turns)."""
+    nb = x.shape[0]
+    n = x.shape[1]
+    for b in range(nb):
+        others = 0
+        for i in range(n):
+            others += 1 if alive[b, i] else 0
+        for i in range(n):
+            kind = kinds[i]
+            if kind == K_CORNERS and ev_died[b, i]:
+                # Corners.onDeath: a poor round (under 75 % of the others killed) moves to the next corner
+                start = mem[b, i, M_VAR + 2]
+                if start > 0 and (start - others) / start < 0.75:
+                    c = mem[b, i, M_STATIC] + 90
+                    mem[b, i, M_STATIC] = -90.0 if c == 270 else c
+            if kind == K_NONE or kind == K_DUCK or not alive[b, i]:
+                continue
+            if energy[b, i] == 0.0:
+                continue
+            _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot,
+                    ev_robot_bearing, ev_fault, ev_hitby, ev_hitby_bearing, cmd)
+            rem[0] = dist_rem[b, i]
+            rem[1] = body_rem[b, i]
+            rem[2] = gun_rem[b, i]
+            rem[3] = radar_rem[b, i]
+            t = int(mem[b, i, M_TARGET])
+            tx = x[b, t] if t >= 0 else 0.0
+            ty = y[b, t] if t >= 0 else 0.0
+            for _ in range(24):
+                in_handler = mem[b, i, M_HLEN] > 0
+                if in_handler:
+                    base, lenp, posp, startp = M_HOPS, M_HLEN, M_HPOS, M_HSTART
+                else:
+                    base, lenp, posp, startp = M_MOPS, M_MLEN, M_MPOS, M_MSTART
+                pos = int(mem[b, i, posp])
+                if pos >= int(mem[b, i, lenp]):
+                    if in_handler:
+                        mem[b, i, M_HLEN] = 0
+                        mem[b, i, M_HPOS] = 0
+                        mem[b, i, M_HPRIO] = 0
+                        mem[b, i, M_HSTART] = 0
+                    else:
+                        _refill_main(kind, mem, b, i, h[b, i], width, height, others - 1)
+                    continue
+                op = mem[b, i, base + 2 * pos]
+                val = mem[b, i, base + 2 * pos + 1]
+                if mem[b, i, startp] == 1:
+                    if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
+                        mem[b, i, posp] = pos + 1
+                        mem[b, i, startp] = 0
+                        continue
+                    break  # still running: nothing new this turn
+                mem[b, i, startp] = 1
+                if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x[b, i], y[b, i], rem):
+                    break
+
+
+class ScriptedBots:
+    """Sample-robot behaviour for some robots of an Arena (all battles)."""
+
+    def __init__(self, arena: Arena, names: list[str | None]) -> None:
+        if len(names) != arena.n_robots:
+            raise ValueError(f"names has {len(names)} entries, the arena has {arena.n_robots} robots")
+        self.arena = arena
+        self.names = list(names)
+        self.kinds = np.array([bot_kind(n) for n in names], dtype=np.int64)
+        self.mem = np.zeros((arena.n_battles, arena.n_robots, M_SIZE))
+        self._rem = np.zeros(4)
+        self._apply_flags()
+        self.reset()
+
+    def _apply_flags(self) -> None:
+        s = self.arena.state
+        for i, name in enumerate(self.names):
+            if name is None:
+                continue
+            s.is_advanced[:, i] = name in ADVANCED_BOTS
+            s.adjust_gun_for_body[:, i] = name == "Tracker"
+            s.adjust_radar_for_body[:, i] = False
+            s.adjust_radar_for_gun[:, i] = False
+
+    def reset(self, mask: np.ndarray | None = None) -> None:
+        """Clear the per-round memory of the masked battles (statics such as Corners' corner stay)."""
+        idx = slice(None) if mask is None else np.asarray(mask, dtype=bool)
+        keep = self.mem[idx, :, M_STATIC:].copy()
+        self.mem[idx] = 0.0
+        self.mem[idx, :, M_STATIC:] = keep
+        self.mem[idx, :, M_TARGET] = -1.0
+        s = self.arena.state
+        bots = self.kinds != K_NONE
+        s.max_velocity[idx] = np.where(bots[None, :], 8.0, s.max_velocity[idx])
+
+    def commands(self, cmd: np.ndarray) -> np.ndarray:
+        """Fill the scripted robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""
+        s = self.arena.state
+        bots = self.kinds != K_NONE
+        cmd[:, bots, :4] = np.nan
+        cmd[:, bots, 4] = 0.0
+        bots_step(self.kinds, self.mem, s.x, s.y, s.heading, s.gun_heading, s.radar_heading, s.energy, s.alive,
+                  s.team, s.distance_remaining, s.body_turn_remaining, s.gun_turn_remaining,
+                  s.radar_turn_remaining, s.max_velocity, s.fire_assist, s.scan_request, s.scanned, s.ev_hit_wall,
+                  s.ev_hit_robot, s.ev_hit_robot_bearing, s.ev_at_fault, s.ev_hit_by_bullet,
+                  s.ev_hit_by_bullet_bearing, s.ev_died, float(self.arena.scenario.width),
+                  float(self.arena.scenario.height), cmd, self._rem)
+        return cmd

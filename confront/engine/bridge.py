@@ -1,12 +1,18 @@
 """Python side of the engine bridge: a loopback TCP server that answers BridgeBot's per-turn requests.
 
-Protocol v1 (one line per message). Robot -> Python: JSON objects, ``{"v": 1, "type": "hello", "token",
-"name", "team", "round", "rounds", "width", "height"}`` once per round and connection, then ``"obs"``
-every turn (own state, latest scans, events since the last turn), ``"end"`` at death or round end.
-Python -> robot: ``OK 1`` after a valid hello, ``A TURN AHEAD TURN GUN RADAR FIRE`` per obs (radians,
-+ clockwise; ``NaN`` keeps the remaining value; fire 0 = no shot). A robot whose Python side fails
-(no answer within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the
-round and reports ``bridge-failed``; the runner collects those reports.
+Protocol v1, one line per message (UTF-8). Robot -> Python:
+- once per round and connection, JSON ``{"v": 1, "type": "hello", "token", "name", "team" (team-mates'
+  names joined by ";"), "round", "rounds", "width", "height"}``;
+- every turn ``O ROUND TURN X Y HEADING GUN_HEADING RADAR_HEADING VELOCITY ENERGY GUN_HEAT OTHERS
+  DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS``: SCANS is the latest sighting of each robot, joined by "|",
+  each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``; EVENTS a JSON list of
+  the events since the last turn; TURN is the engine turn the answer takes effect in;
+- ``E ROUND TIME HOW ENERGY`` at death or round end.
+Python -> robot: ``OK 1`` after a valid hello, ``A TURN AHEAD TURN GUN RADAR FIRE`` per observation
+(radians, + clockwise; ``NaN`` keeps the remaining value; fire 0 = no shot). A compact text line instead
+of JSON keeps the per-turn cost low (measured: docs/engine.md). A robot whose Python side fails (no answer
+within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the round and
+reports ``bridge-failed``; the runner collects those reports.
 """
 
 from __future__ import annotations
@@ -16,7 +22,6 @@ import importlib
 import json
 import math
 import secrets
-import selectors
 import socket
 import sys
 import threading
@@ -75,23 +80,11 @@ class Observation:
 Action = Sequence[float]
 Policy = Callable[[Observation], Action]
 
-_FLOATS = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "energy", "gun_heat",
-           "distance_remaining")
-_SCAN_FLOATS = ("bearing", "distance", "heading", "velocity", "energy", "x", "y")
-
-
 def _num(d: dict, key: str) -> float:
     v = d.get(key)
     if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
         raise ValueError(f"bad or missing number {key!r}: {v!r}")
     return float(v)
-
-
-def _int(d: dict, key: str) -> int:
-    v = d.get(key)
-    if isinstance(v, bool) or not isinstance(v, int):
-        raise ValueError(f"bad or missing integer {key!r}: {v!r}")
-    return v
 
 
 def _check_version(msg: dict, kind: str) -> None:
@@ -116,28 +109,43 @@ def parse_hello(line: str, token: str) -> dict:
     return msg
 
 
-def parse_observation(line: str | dict, hello: dict) -> Observation:
-    """Validate one obs line (from the robot introduced by ``hello``) into an :class:`Observation`."""
-    msg = json.loads(line) if isinstance(line, str) else line
-    if not isinstance(msg, dict):
-        raise ValueError("observation is not a JSON object")
-    _check_version(msg, "obs")
-    scans_raw = msg.get("scans")
-    events = msg.get("events")
-    if not isinstance(scans_raw, list) or not isinstance(events, list):
-        raise ValueError("observation needs lists 'scans' and 'events'")
+def _finite(text: str, what: str) -> float:
+    v = float(text)
+    if not math.isfinite(v):
+        raise ValueError(f"non-finite {what}: {text!r}")
+    return v
+
+
+_OBS_FIELDS = 13
+
+
+def parse_observation(line: str, hello: dict) -> Observation:
+    """Validate one ``O ...`` line (from the robot introduced by ``hello``) into an :class:`Observation`."""
+    parts = line.split("\t")
+    head = parts[0].split(" ")
+    if len(parts) != 3 or head[0] != "O" or len(head) != _OBS_FIELDS:
+        raise ValueError(f"bad observation line: {line[:80]!r}")
+    rnd, turn, others = int(head[1]), int(head[2]), int(head[11])
+    x, y, heading, gun, radar, vel, energy, heat = (_finite(v, "state value") for v in head[3:11])
+    remaining = _finite(head[12], "distance_remaining")
     scans = []
-    for s in scans_raw:
-        if not isinstance(s, dict) or not isinstance(s.get("name"), str):
-            raise ValueError(f"bad scan {s!r}")
-        scans.append(Scan(s["name"], _int(s, "time"), bool(s.get("teammate")),
-                          *(_num(s, k) for k in _SCAN_FLOATS)))
-    floats = {k: _num(msg, k) for k in _FLOATS}
+    for item in parts[1].split("|") if parts[1] else ():
+        f = item.split(";")
+        if len(f) != 10 or f[2] not in ("0", "1"):
+            raise ValueError(f"bad scan: {item[:80]!r}")
+        scans.append(Scan(f[0], int(f[1]), f[2] == "1", *(_finite(v, "scan value") for v in f[3:])))
+    events: tuple[dict, ...] = ()
+    if parts[2] != "[]":
+        raw = json.loads(parts[2])
+        if not isinstance(raw, list) or not all(isinstance(e, dict) for e in raw):
+            raise ValueError(f"events must be a JSON list of objects: {parts[2][:80]!r}")
+        events = tuple(raw)
     team = tuple(t for t in hello["team"].split(";") if t)
     return Observation(
-        robot=hello["name"], teammates=team, round=_int(msg, "round"), turn=_int(msg, "turn"),
-        others=_int(msg, "others"), width=float(hello["width"]), height=float(hello["height"]),
-        scans=tuple(scans), events=tuple(e for e in events if isinstance(e, dict)), **floats,
+        robot=hello["name"], teammates=team, round=rnd, turn=turn, x=x, y=y, heading=heading,
+        gun_heading=gun, radar_heading=radar, velocity=vel, energy=energy, gun_heat=heat, others=others,
+        distance_remaining=remaining, width=float(hello["width"]), height=float(hello["height"]),
+        scans=tuple(scans), events=events,
     )
 
 
@@ -163,15 +171,12 @@ class BridgeStats:
     errors: list[str] = field(default_factory=list)
 
 
-@dataclass
-class _Conn:
-    sock: socket.socket
-    buf: bytes = b""
-    hello: dict | None = None
-
-
 class BridgeServer:
-    """Serves one policy to every BridgeBot of a battle (team-mates share it) on 127.0.0.1."""
+    """Serves one policy to every BridgeBot of a battle (team-mates share it) on 127.0.0.1.
+
+    One thread per robot connection with blocking reads (the fewest system calls per turn); policy
+    calls are serialised by a lock, so the policy need not be thread-safe.
+    """
 
     def __init__(self, policy: Policy, token: str | None = None, port: int = 0) -> None:
         self.policy = policy
@@ -179,35 +184,46 @@ class BridgeServer:
         self.stats = BridgeStats()
         self.on_hello: Callable[[dict], None] | None = None
         self._listener = socket.create_server((LOOPBACK, port))
-        self._listener.setblocking(False)
+        self._listener.settimeout(0.1)
         self.port: int = self._listener.getsockname()[1]
-        self._sel = selectors.DefaultSelector()
-        self._sel.register(self._listener, selectors.EVENT_READ, None)
         self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._conns: list[socket.socket] = []
         self._thread: threading.Thread | None = None
 
     def start(self) -> BridgeServer:
-        """Serve in a daemon thread."""
+        """Accept robots in a daemon thread."""
         self._thread = threading.Thread(target=self.serve_forever, name="confront-bridge", daemon=True)
         self._thread.start()
         return self
 
     def serve_forever(self) -> None:
-        """Accept robots and answer their lines until :meth:`stop`."""
-        while not self._stop.is_set():
-            for key, _ in self._sel.select(timeout=0.1):
-                if key.data is None:
-                    self._accept()
-                else:
-                    self._read(key.data)
-        for key in list(self._sel.get_map().values()):
-            with contextlib.suppress(OSError):
-                key.fileobj.close()  # type: ignore[union-attr]
-        self._sel.close()
+        """Accept robots until :meth:`stop`; each connection is served by its own thread."""
+        try:
+            while not self._stop.is_set():
+                try:
+                    sock, _ = self._listener.accept()
+                except TimeoutError:
+                    continue
+                except OSError:
+                    break
+                sock.settimeout(None)
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                with self._lock:
+                    self.stats.connections += 1
+                    self._conns.append(sock)
+                threading.Thread(target=self._serve, args=(sock,), daemon=True).start()
+        finally:
+            self._listener.close()
 
     def stop(self) -> None:
         """Stop serving and close every socket."""
         self._stop.set()
+        with self._lock:
+            for sock in self._conns:
+                with contextlib.suppress(OSError):
+                    sock.shutdown(socket.SHUT_RDWR)
+                sock.close()
         if self._thread is not None:
             self._thread.join(timeout=5)
 
@@ -217,66 +233,37 @@ class BridgeServer:
     def __exit__(self, *exc: object) -> None:
         self.stop()
 
-    def _accept(self) -> None:
-        try:
-            sock, _ = self._listener.accept()
-        except BlockingIOError:
-            return
-        sock.setblocking(False)
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.stats.connections += 1
-        self._sel.register(sock, selectors.EVENT_READ, _Conn(sock))
+    def _error(self, text: str) -> None:
+        with self._lock:
+            self.stats.errors.append(text)
 
-    def _drop(self, conn: _Conn, reason: str | None) -> None:
-        if reason:
-            self.stats.errors.append(reason)
-        with contextlib.suppress(KeyError, ValueError):
-            self._sel.unregister(conn.sock)
-        conn.sock.close()
-
-    def _read(self, conn: _Conn) -> None:
+    def _serve(self, sock: socket.socket) -> None:
+        hello: dict | None = None
         try:
-            data = conn.sock.recv(65536)
-        except (BlockingIOError, InterruptedError):
-            return
+            with sock, sock.makefile("r", encoding="utf-8", newline="\n") as lines:
+                for line in lines:
+                    if len(line) > MAX_LINE:
+                        raise ValueError("line too long")
+                    line = line.rstrip("\n")
+                    if hello is None:
+                        hello = parse_hello(line, self.token)
+                        if self.on_hello is not None:
+                            self.on_hello(hello)
+                        sock.sendall(f"OK {PROTOCOL_VERSION}\n".encode())
+                    elif line.startswith("E "):
+                        with self._lock:
+                            self.stats.rounds_ended += 1
+                    else:
+                        obs = parse_observation(line, hello)
+                        with self._lock:
+                            action = self.policy(obs)
+                            self.stats.decisions += 1
+                        sock.sendall(format_action(obs.turn, action).encode())
         except OSError as err:
-            self._drop(conn, f"recv: {err}")
-            return
-        if not data:
-            self._drop(conn, None)
-            return
-        conn.buf += data
-        if len(conn.buf) > MAX_LINE:
-            self._drop(conn, "line too long")
-            return
-        while b"\n" in conn.buf:
-            line, conn.buf = conn.buf.split(b"\n", 1)
-            try:
-                reply = self._handle(conn, line.decode("utf-8"))
-                if reply:
-                    conn.sock.setblocking(True)
-                    conn.sock.sendall(reply.encode())
-                    conn.sock.setblocking(False)
-            except Exception as err:  # a bad message or a failing policy ends this robot's session
-                name = conn.hello["name"] if conn.hello else "?"
-                self._drop(conn, f"{name}: {type(err).__name__}: {err}")
-                return
-
-    def _handle(self, conn: _Conn, line: str) -> str | None:
-        if conn.hello is None:
-            conn.hello = parse_hello(line, self.token)
-            if self.on_hello is not None:
-                self.on_hello(conn.hello)
-            return f"OK {PROTOCOL_VERSION}\n"
-        msg = json.loads(line)
-        if isinstance(msg, dict) and msg.get("type") == "end":
-            _check_version(msg, "end")
-            self.stats.rounds_ended += 1
-            return None
-        obs = parse_observation(msg, conn.hello)
-        action = self.policy(obs)
-        self.stats.decisions += 1
-        return format_action(obs.turn, action)
+            if not self._stop.is_set():
+                self._error(f"{hello['name'] if hello else '?'}: connection: {err}")
+        except Exception as err:  # a bad message or a failing policy ends this robot's session
+            self._error(f"{hello['name'] if hello else '?'}: {type(err).__name__}: {err}")
 
 
 def nearest_enemy_policy(obs: Observation) -> Action:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import socket
+import time
 
 import pytest
 
@@ -20,18 +21,17 @@ from confront.engine.bridge import (
 
 HELLO = {"v": 1, "type": "hello", "token": "t0k", "name": "confront.BridgeBot* (1)",
          "team": "confront.BridgeBot* (2)", "round": 0, "rounds": 3, "width": 800.0, "height": 600.0}
-OBS = {"v": 1, "type": "obs", "round": 0, "turn": 7, "x": 100.0, "y": 200.0, "heading": 0.0,
-       "gun_heading": 0.5, "radar_heading": 1.0, "velocity": 8.0, "energy": 99.5, "gun_heat": 2.3,
-       "others": 2, "distance_remaining": 12.0,
-       "scans": [{"name": "sample.Walls", "time": 6, "teammate": False, "bearing": 0.5, "distance": 300.0,
-                  "heading": 1.0, "velocity": -8.0, "energy": 80.0, "x": 400.0, "y": 200.0},
-                 {"name": "confront.BridgeBot* (2)", "time": 5, "teammate": True, "bearing": 0.1,
-                  "distance": 50.0, "heading": 2.0, "velocity": 0.0, "energy": 100.0, "x": 105.0, "y": 250.0}],
-       "events": [{"type": "hit_wall"}]}
+SCAN_WALLS = "sample.Walls;6;0;0.5;300.0;1.0;-8.0;80.0;400.0;200.0"
+SCAN_MATE = "confront.BridgeBot* (2);5;1;0.1;50.0;2.0;0.0;100.0;105.0;250.0"
+
+
+def obs_line(turn: int = 7, heat: float = 2.3, scans: str = f"{SCAN_WALLS}|{SCAN_MATE}",
+             events: str = '[{"type":"hit_wall"}]') -> str:
+    return f"O 0 {turn} 100.0 200.0 0.0 0.5 1.0 8.0 99.5 {heat} 2 12.0\t{scans}\t{events}"
 
 
 def test_parse_observation_values() -> None:
-    obs = parse_observation(json.dumps(OBS), parse_hello(json.dumps(HELLO), "t0k"))
+    obs = parse_observation(obs_line(), parse_hello(json.dumps(HELLO), "t0k"))
     assert (obs.robot, obs.teammates, obs.turn, obs.others) == ("confront.BridgeBot* (1)",
                                                                 ("confront.BridgeBot* (2)",), 7, 2)
     assert (obs.x, obs.y, obs.energy, obs.gun_heat, obs.width) == (100.0, 200.0, 99.5, 2.3, 800.0)
@@ -40,13 +40,21 @@ def test_parse_observation_values() -> None:
 
 
 @pytest.mark.parametrize(
-    ("change", "match"),
-    [({"v": 2}, "version"), ({"type": "hello"}, "obs"), ({"x": "1"}, "'x'"), ({"turn": 1.5}, "'turn'"),
-     ({"energy": float("nan")}, "'energy'"), ({"scans": {}}, "scans"), ({"scans": [{"name": 3}]}, "scan")],
+    "line",
+    [
+        obs_line().replace("O 0", "X 0"),
+        obs_line().replace(" 12.0\t", "\t"),
+        obs_line().replace("99.5", "nan"),
+        obs_line().replace("O 0 7", "O 0 7.5"),
+        obs_line(scans="sample.Walls;6;2;0;0;0;0;0;0;0"),
+        obs_line(scans="sample.Walls;6;0;0.5"),
+        obs_line(events='{"type":"x"}'),
+        obs_line().split("\t")[0],
+    ],
 )
-def test_bad_observations_rejected(change: dict, match: str) -> None:
-    with pytest.raises(ValueError, match=match):
-        parse_observation(json.dumps({**OBS, **change}), HELLO)
+def test_bad_observations_rejected(line: str) -> None:
+    with pytest.raises(ValueError):
+        parse_observation(line, HELLO)
 
 
 def test_bad_hello_rejected() -> None:
@@ -67,7 +75,7 @@ def test_format_action() -> None:
 
 
 def test_reference_policy_aims_at_nearest_enemy() -> None:
-    obs = parse_observation(json.dumps({**OBS, "gun_heat": 0.0}), HELLO)
+    obs = parse_observation(obs_line(heat=0.0), HELLO)
     ahead, body, gun, radar, fire = nearest_enemy_policy(obs)
     # enemy due east (bearing pi/2), gun at 0.5 rad: turn gun by pi/2 - 0.5
     assert gun == pytest.approx(math.pi / 2 - 0.5)
@@ -100,12 +108,15 @@ def test_server_round_trip_on_loopback() -> None:
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps(HELLO) + "\n").encode())
             assert _lines(s, 1) == ["OK 1"]
-            s.sendall((json.dumps(OBS) + "\n" + json.dumps({**OBS, "turn": 8}) + "\n").encode())
+            s.sendall((obs_line() + "\n" + obs_line(turn=8, scans="", events="[]") + "\n").encode())
             assert _lines(s, 2) == ["A 7 7.0 NaN 0.0 0.0 1.5", "A 8 8.0 NaN 0.0 0.0 1.5"]
-            s.sendall(b'{"v":1,"type":"end","round":0,"turn":9,"how":"death","energy":0}\n')
+            s.sendall(b"E 0 9 death 0.0\n")
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps({**HELLO, "token": "bad"}) + "\n").encode())
             assert _lines(s, 1) == []  # closed without an answer
-    assert [o.turn for o in seen] == [7, 8]
-    assert server.stats.decisions == 2 and server.stats.connections == 2
+        deadline = time.monotonic() + 10  # the server threads finish their bookkeeping after closing
+        while time.monotonic() < deadline and (not server.stats.errors or not server.stats.rounds_ended):
+            time.sleep(0.01)
+    assert [o.turn for o in seen] == [7, 8] and seen[1].scans == () and seen[1].events == ()
+    assert server.stats.decisions == 2 and server.stats.connections == 2 and server.stats.rounds_ended == 1
     assert len(server.stats.errors) == 1 and "token" in server.stats.errors[0]

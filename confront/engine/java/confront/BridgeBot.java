@@ -27,9 +27,11 @@ import robocode.util.Utils;
  * A tank that hands every turn's decision to a Python policy over a loopback TCP socket.
  *
  * Settings come from JVM system properties (the engine runs with -DNOSECURITY=true so that robots may use
- * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs. Protocol version 1,
- * one line per message: the robot sends JSON objects ("hello" once per round, then "obs" every turn,
- * "end" at round end); Python answers "OK 1" to hello and "A TURN AHEAD TURN GUN RADAR FIRE" to each obs
+ * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs, confront.bridge.every
+ * (ask Python in every k-th turn only; the commands keep running in between). Protocol version 1,
+ * one line per message: the robot sends a JSON "hello" once per round, then an "O ..." observation line
+ * every turn and "E ..." at death or round end (format in confront/engine/bridge.py); Python answers
+ * "OK 1" to hello and "A TURN AHEAD TURN GUN RADAR FIRE" to each observation
  * (radians, + clockwise; "NaN" keeps the current remaining value; fire 0 = no shot). Any missing, late
  * or malformed answer switches the robot to a built-in behaviour for the rest of the round and prints
  * "CONFRONT bridge-failed REASON" for the runner to report.
@@ -41,6 +43,9 @@ public class BridgeBot extends TeamRobot {
     private OutputStream out2;
     private boolean failed;
     private boolean finished;
+    private long rttN;
+    private long rttSum;
+    private long rttSlow;
     private final Map<String, String> scans = new LinkedHashMap<>();
     private final StringBuilder events = new StringBuilder();
     private double enemyBearing = Double.NaN;
@@ -51,9 +56,13 @@ public class BridgeBot extends TeamRobot {
         setAdjustGunForRobotTurn(true);
         setAdjustRadarForRobotTurn(true);
         setAdjustRadarForGunTurn(true);
+        // act once before connecting: the engine waits for each robot's first action at round start, and
+        // a slow first action often costs the full wait there (lost wake-up in RobotPeer.startRound)
+        execute();
         connect();
+        int every = Integer.parseInt(System.getProperty("confront.bridge.every", "1"));
         while (true) {
-            if (!failed && !finished) {
+            if (!failed && !finished && (getTime() + 1) % every == 0) {
                 try {
                     decide();
                 } catch (IOException | RuntimeException e) {
@@ -102,20 +111,24 @@ public class BridgeBot extends TeamRobot {
     private void decide() throws IOException {
         long turn = getTime() + 1;  // the commands set now take effect in this engine turn
         StringBuilder b = new StringBuilder(256);
-        b.append("{\"v\":").append(VERSION).append(",\"type\":\"obs\",\"round\":").append(getRoundNum())
-                .append(",\"turn\":").append(turn)
-                .append(",\"x\":").append(getX()).append(",\"y\":").append(getY())
-                .append(",\"heading\":").append(getHeadingRadians())
-                .append(",\"gun_heading\":").append(getGunHeadingRadians())
-                .append(",\"radar_heading\":").append(getRadarHeadingRadians())
-                .append(",\"velocity\":").append(getVelocity()).append(",\"energy\":").append(getEnergy())
-                .append(",\"gun_heat\":").append(getGunHeat()).append(",\"others\":").append(getOthers())
-                .append(",\"distance_remaining\":").append(getDistanceRemaining())
-                .append(",\"scans\":[").append(String.join(",", scans.values()))
-                .append("],\"events\":[").append(events).append("]}");
+        b.append("O ").append(getRoundNum()).append(' ').append(turn)
+                .append(' ').append(getX()).append(' ').append(getY())
+                .append(' ').append(getHeadingRadians()).append(' ').append(getGunHeadingRadians())
+                .append(' ').append(getRadarHeadingRadians()).append(' ').append(getVelocity())
+                .append(' ').append(getEnergy()).append(' ').append(getGunHeat())
+                .append(' ').append(getOthers()).append(' ').append(getDistanceRemaining())
+                .append('\t').append(String.join("|", scans.values()))
+                .append("\t[").append(events).append(']');
         events.setLength(0);
+        long t0 = System.nanoTime();
         send(b.toString());
         String line = in.readLine();
+        long dt = System.nanoTime() - t0;
+        rttN++;
+        rttSum += dt;
+        if (dt > 1000000) {
+            rttSlow++;
+        }
         if (line == null) {
             throw new IOException("python side closed the connection");
         }
@@ -202,12 +215,11 @@ public class BridgeBot extends TeamRobot {
             enemyBearing = e.getBearingRadians();
             lastScan = e.getTime();
         }
-        scans.put(e.getName(), "{\"name\":" + str(e.getName()) + ",\"time\":" + e.getTime()
-                + ",\"teammate\":" + mate + ",\"bearing\":" + e.getBearingRadians()
-                + ",\"distance\":" + e.getDistance() + ",\"heading\":" + e.getHeadingRadians()
-                + ",\"velocity\":" + e.getVelocity() + ",\"energy\":" + e.getEnergy()
-                + ",\"x\":" + (getX() + e.getDistance() * Math.sin(abs))
-                + ",\"y\":" + (getY() + e.getDistance() * Math.cos(abs)) + "}");
+        scans.put(e.getName(), e.getName() + ";" + e.getTime() + ";" + (mate ? 1 : 0)
+                + ";" + e.getBearingRadians() + ";" + e.getDistance() + ";" + e.getHeadingRadians()
+                + ";" + e.getVelocity() + ";" + e.getEnergy()
+                + ";" + (getX() + e.getDistance() * Math.sin(abs))
+                + ";" + (getY() + e.getDistance() * Math.cos(abs)));
     }
 
     @Override
@@ -241,11 +253,13 @@ public class BridgeBot extends TeamRobot {
         if (finished) {
             return;
         }
+        // round-trip statistics of this round, for the runner's report
+        out.println("CONFRONT bridge-stats round=" + getRoundNum() + " decisions=" + rttN + " rtt_total_us="
+                + rttSum / 1000 + " rtt_over_1ms=" + rttSlow);
         finished = true;
         if (!failed && socket != null) {
             try {
-                send("{\"v\":" + VERSION + ",\"type\":\"end\",\"round\":" + getRoundNum() + ",\"turn\":" + getTime()
-                        + ",\"how\":\"" + how + "\",\"energy\":" + getEnergy() + "}");
+                send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy());
             } catch (IOException e) {
                 // the round is over anyway
             }

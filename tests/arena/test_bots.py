@@ -1,0 +1,106 @@
+"""Scripted sample robots behave like Robocode's samples (observable behaviour)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from confront.arena.bots import BOT_NAMES, ScriptedBots
+from confront.arena.core import Arena
+from confront.arena.scenarios import get_scenario
+
+
+def run(names, positions, turns, seed=0):
+    sc = get_scenario("melee").replace(teams=tuple(1 for _ in names), initial_positions=tuple(positions))
+    arena = Arena(sc, 1, seed=seed, order="fixed")
+    bots = ScriptedBots(arena, list(names))
+    cmd = arena.idle_commands()
+    traj = []
+    for _ in range(turns):
+        bots.commands(cmd)
+        arena.step(cmd)
+        s = arena.state
+        traj.append(np.stack([s.x[0], s.y[0], s.heading[0], s.velocity[0], s.energy[0], s.gun_heading[0]], 1))
+        if s.done[0]:
+            break
+    return arena, np.array(traj)
+
+
+def test_sitting_duck_sits():
+    arena, tr = run(["SittingDuck", "SittingDuck"], [(100, 100, 0), (700, 500, 0)], 50)
+    assert np.all(tr[:, :, :4] == tr[0, :, :4])
+
+
+def test_spinbot_circles_at_speed_5():
+    _, tr = run(["SpinBot", "SittingDuck"], [(400, 300, 0), (780, 580, 0)], 60)
+    v = tr[10:, 0, 3]
+    assert np.all(v == 5.0)
+    dh = np.diff(np.unwrap(tr[10:, 0, 2]))
+    assert dh == pytest.approx(math.radians(10 - 0.75 * 5))  # turning at the limit for speed 5
+    # the positions lie on one circle: chord 5 per turn of 6.25 deg, radius 5 / (2 sin(3.125 deg))
+    x, y = tr[10:, 0, 0], tr[10:, 0, 1]
+    sol = np.linalg.lstsq(np.stack([2 * x, 2 * y, np.ones_like(x)], 1), x * x + y * y, rcond=None)[0]
+    r = np.hypot(x - sol[0], y - sol[1])
+    assert r == pytest.approx(5 / (2 * math.sin(math.radians(3.125))), abs=1e-6)
+
+
+def test_walls_drives_along_the_walls():
+    _, tr = run(["Walls", "SittingDuck"], [(400, 300, 30), (100, 500, 0)], 400)
+    x, y, h = tr[150:, 0, 0], tr[150:, 0, 1], tr[150:, 0, 2]
+    near = np.minimum.reduce([x - 18, 782 - x, y - 18, 582 - y])
+    assert np.mean(near < 1.0) > 0.9  # hugging a wall nearly all the time
+    assert np.all(np.isclose(np.mod(h, math.pi / 2), 0) | np.isclose(np.mod(h, math.pi / 2), math.pi / 2)
+                  | (tr[150:, 0, 3] == 0))
+    assert tr[-1, 1, 4] < 100  # and hits the duck
+
+
+def test_tracker_closes_in_and_fires():
+    _, tr = run(["Tracker", "SittingDuck"], [(100, 100, 0), (600, 500, 0)], 300)
+    d = np.hypot(tr[:, 0, 0] - 600, tr[:, 0, 1] - 500)
+    assert d[0] > 600 and d[-1] < 160
+    assert tr[-1, 1, 4] < 100
+
+
+def test_ramfire_rams():
+    arena, tr = run(["RamFire", "SittingDuck"], [(100, 100, 0), (500, 400, 0)], 200)
+    d = np.hypot(tr[:, 0, 0] - 500, tr[:, 0, 1] - 400)
+    assert d.min() < 36 * math.sqrt(2)  # boxes overlapping
+    assert arena.state.score[0, 0, 4] > 0  # ram damage scored
+
+
+def test_fire_turns_its_gun_and_shoots_what_it_sees():
+    _, tr = run(["Fire", "SittingDuck"], [(400, 300, 0), (400, 500, 90)], 150)
+    assert np.all(tr[:, 0, :2] == [400, 300])  # never moves unless hit
+    assert tr[-1, 1, 4] < 100
+
+
+def test_corners_goes_to_a_corner():
+    _, tr = run(["Corners", "SittingDuck"], [(400, 300, 0), (700, 100, 0)], 400)
+    x, y = tr[-1, 0, 0], tr[-1, 0, 1]
+    assert (x < 20 or x > 780) and (y < 20 or y > 580)
+
+
+def test_crazy_moves_and_turns():
+    _, tr = run(["Crazy", "SittingDuck"], [(400, 300, 0), (100, 100, 0)], 200)
+    assert np.abs(tr[:, 0, 3]).max() == 8.0
+    assert np.ptp(np.unwrap(tr[:, 0, 2])) > math.radians(90)
+
+
+def test_every_bot_survives_a_melee_round():
+    names = list(BOT_NAMES)
+    sc = get_scenario("melee").replace(teams=tuple(1 for _ in names), max_turns=3000)
+    arena = Arena(sc, 4, seed=5)
+    bots = ScriptedBots(arena, names)
+    cmd = arena.idle_commands()
+    for _ in range(3000):
+        bots.commands(cmd)
+        arena.step(cmd)
+        if arena.state.done.all():
+            break
+    assert arena.state.score_total.sum() > 0
+
+
+def test_unknown_bot_name():
+    arena = Arena("1v1", 1)
+    with pytest.raises(ValueError, match="unknown bot"):
+        ScriptedBots(arena, ["SpinBot", "Nope"])

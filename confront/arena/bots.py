@@ -20,8 +20,8 @@ each robot has a small state machine in a per-robot memory row:
   at the scanned robot when the gun and radar turned together).
 
 Usage: ``bots = ScriptedBots(arena, ["SpinBot", None, ...])`` (a name per robot, None = driven by
-someone else), then every turn ``bots.commands(cmd)`` fills those robots' rows of ``cmd``; call
-``bots.reset(mask)`` after ``arena.reset(mask)``.
+someone else), then every turn ``bots.commands(cmd)`` fills those robots' rows of ``cmd``. A new
+round (``state.round`` changed) clears the memory of that battle's bots by itself.
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ M_HPRIO, M_HLEN, M_HPOS, M_HSTART, M_MLEN, M_MPOS, M_MSTART, M_PHASE = range(8)
 M_VAR = 8  # 8 bot variables
 M_SAVE = 16  # stop(): saved distance, body, gun, radar remaining
 M_TARGET = 20  # scanned target of the running handler (fire assist)
+M_FRESH = 21  # 1 while the handler started in this decision (fire assist needs the scan's own turn)
 M_HOPS = 24
 M_MOPS = M_HOPS + 2 * Q
 M_STATIC = M_MOPS + 2 * Q  # kept across rounds (Corners' corner)
@@ -79,6 +80,7 @@ def _push(mem, b, i, base, lenpos, op, val):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _start_handler(mem, b, i, prio):
+    mem[b, i, M_FRESH] = 1.0
     mem[b, i, M_HPRIO] = prio
     mem[b, i, M_HLEN] = 0
     mem[b, i, M_HPOS] = 0
@@ -221,7 +223,7 @@ def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, rem):
+def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, rem, gun_eq_radar):
     """Write an operation's commands; True if it takes the turn (blocking)."""
     if op == O_MOVE:
         cmd[b, i, 0] = val
@@ -237,7 +239,9 @@ def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, 
         return True
     if op == O_FIRE or op == O_FIREASSIST:
         cmd[b, i, 4] = val
-        if op == O_FIREASSIST:
+        # fire assist (BasicRobotProxy.setFireImpl): fire() in onScannedRobot in the scan's own turn, gun
+        # and radar pointing the same way
+        if op == O_FIREASSIST and mem[b, i, M_FRESH] == 1.0 and gun_eq_radar:
             assist[b, i] = normal_absolute_angle(math.atan2(tx - x, ty - y))
         return True
     if op == O_SCAN:
@@ -440,7 +444,7 @@ def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_r
             tx = x[b, t] if t >= 0 else 0.0
             ty = y[b, t] if t >= 0 else 0.0
             for _ in range(24):
-                in_handler = mem[b, i, M_HLEN] > 0
+                in_handler = mem[b, i, M_HPRIO] > 0  # a handler with no operations ends at once
                 if in_handler:
                     base, lenp, posp, startp = M_HOPS, M_HLEN, M_HPOS, M_HSTART
                 else:
@@ -464,8 +468,10 @@ def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_r
                         continue
                     break  # still running: nothing new this turn
                 mem[b, i, startp] = 1
-                if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x[b, i], y[b, i], rem):
+                if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x[b, i], y[b, i], rem,
+                          gh[b, i] == rh[b, i]):
                     break
+            mem[b, i, M_FRESH] = 0.0
 
 
 class ScriptedBots:
@@ -480,6 +486,7 @@ class ScriptedBots:
         self.mem = np.zeros((arena.n_battles, arena.n_robots, M_SIZE))
         self._rem = np.zeros(4)
         self._apply_flags()
+        self._round = arena.state.round.copy()
         self.reset()
 
     def _apply_flags(self) -> None:
@@ -506,6 +513,10 @@ class ScriptedBots:
     def commands(self, cmd: np.ndarray) -> np.ndarray:
         """Fill the scripted robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""
         s = self.arena.state
+        new_round = s.round != self._round
+        if new_round.any():
+            self.reset(new_round)
+            self._round[:] = s.round
         bots = self.kinds != K_NONE
         cmd[:, bots, :4] = np.nan
         cmd[:, bots, 4] = 0.0

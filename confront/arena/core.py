@@ -7,6 +7,8 @@ Usage::
     arena.step(cmd)                                  # one Robocode turn in every battle not done
     arena.reset(arena.state.done)                    # next round where the round is over
 
+``arena.state.*`` are live views: ``reset`` clears ``done``, so copy a mask you still need afterwards.
+
 Commands ``(B, R, 5)`` float64, loaded at the start of the turn like an AdvancedRobot's ``set*``
 calls: 0 move distance (px, + ahead), 1 body turn, 2 gun turn, 3 radar turn (radians, + clockwise),
 4 fire power (0 = no fire; clamped to [0.1, 3] and to the energy; refused while the gun is hot).

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -41,9 +42,13 @@ Contestant = str | Team
 Position = tuple[float | None, float | None, float | None]
 
 
+_ROBOT_NAME = re.compile(r"^[A-Za-z_$][\w$.]*\*?( [\w.\-]+)?$")
+
+
 def robot_class(name: str) -> str:
-    """Full class name: 'SpinBot' -> 'sample.SpinBot'; names with a package are kept."""
-    if not name or any(c.isspace() for c in name):
+    """Full class name: 'SpinBot' -> 'sample.SpinBot'; names with a package (and an optional version,
+    as jar robots have: 'pkg.Bot 1.0') are kept."""
+    if not _ROBOT_NAME.match(name or ""):
         raise ValueError(f"bad robot name {name!r}")
     if "." in name:
         return name

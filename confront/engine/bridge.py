@@ -149,6 +149,18 @@ def parse_observation(line: str, hello: dict) -> Observation:
     )
 
 
+def format_observation(obs: Observation) -> str:
+    """The ``O ...`` line of an observation (inverse of :func:`parse_observation`), e.g. to record it."""
+    head = [obs.round, obs.turn, obs.x, obs.y, obs.heading, obs.gun_heading, obs.radar_heading, obs.velocity,
+            obs.energy, obs.gun_heat, obs.others, obs.distance_remaining]
+    scans = "|".join(
+        ";".join([s.name, str(s.time), "1" if s.teammate else "0"]
+                 + [repr(v) for v in (s.bearing, s.distance, s.heading, s.velocity, s.energy, s.x, s.y)])
+        for s in obs.scans
+    )
+    return "O " + " ".join(repr(v) for v in head) + "\t" + scans + "\t" + json.dumps(list(obs.events))
+
+
 def format_action(turn: int, action: Action) -> str:
     """The answer line for ``turn``; NaN = keep the remaining value; fire outside [0, 3] is an error."""
     vals = [float(v) for v in action]

@@ -131,19 +131,21 @@ def run_battle(
     trace: str | os.PathLike[str] | None = None,
     robot_data: Mapping[str, Mapping[str, str]] | None = None,
     install: EngineInstall | None = None,
+    extra_robots: Sequence[str | os.PathLike[str]] = (),
 ) -> EngineRun:
     """Run ``spec`` headless in the real engine and return its results.
 
     ``workdir``: the engine's working directory (created if needed; default a temporary one, removed
     afterwards). ``trace``: write a JSONL trace of every turn there. ``robot_data``: files for the project's
-    robots' data folders, e.g. ``{"ScriptBot": {"script.txt": ...}}``.
+    robots' data folders, e.g. ``{"ScriptBot": {"script.txt": ...}}``. ``extra_robots``: robot jars or
+    robots folders to add (e.g. an exported robot).
     """
     opts = options or EngineOptions()
     install = install or find_engine()
     classes = compile_java(install)
     with tempfile.TemporaryDirectory(prefix="confront-robocode-") as tmp:
         wd = Path(workdir) if workdir is not None else Path(tmp) / "wd"
-        prepare_workdir(wd, install, classes, opts.cpu_constant_ms, spec.teams)
+        prepare_workdir(wd, install, classes, opts.cpu_constant_ms, spec.teams, [Path(p) for p in extra_robots])
         for robot, files in (robot_data or {}).items():
             write_robot_data(wd, robot, files)
         run_dir = Path(tempfile.mkdtemp(prefix="run-", dir=tmp))

@@ -19,11 +19,13 @@ def prepare_workdir(
     classes: Path,
     cpu_constant_ms: float = 10.0,
     teams: Iterable[Team] = (),
+    extra_robots: Iterable[Path] = (),
 ) -> Path:
     """Create (or refresh) a working directory at ``path`` and return it.
 
     The CPU constant (robot time per turn) is written to config/robocode.properties so the engine does not
-    run its 5 s benchmark; sample robots and the project's robots are copied into robots/.
+    run its 5 s benchmark; sample robots, the project's robots and ``extra_robots`` (robot jars, or folders
+    holding package folders, e.g. an exported robot) are copied into robots/.
     """
     if not cpu_constant_ms > 0:
         raise ValueError(f"cpu_constant_ms must be > 0, got {cpu_constant_ms}")
@@ -47,6 +49,14 @@ def prepare_workdir(
         (ours / f"{cls}.properties").write_text(
             f"robot.classname=confront.{cls}\nrobot.name={cls}\nrobocode.version=1.9.3.9\n"
         )
+    for extra in extra_robots:
+        extra = Path(extra)
+        if extra.suffix == ".jar":
+            shutil.copy2(extra, robots / extra.name)
+        elif extra.is_dir():
+            shutil.copytree(extra, robots, dirs_exist_ok=True)
+        else:
+            raise ValueError(f"extra robot must be a .jar or a folder, got {extra}")
     if teams:
         (robots / TEAM_PACKAGE).mkdir(exist_ok=True)
         for team in teams:

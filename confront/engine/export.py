@@ -1,0 +1,228 @@
+"""Exporting a trained policy as a standalone Robocode robot (``confront.PolicyBot``) with its own Java
+inference: the paper's state features, a Q table or an MLP, the four macro moves and the fixed gun/radar
+controller. :class:`ExportedPolicy` is the Python twin; it is also a bridge policy, so the same object can
+be played through the bridge and compared with the exported robot decision by decision.
+
+Policy file (text, data only): ``confront-policy 1``, then ``key value`` lines and ``matrix NAME ROWS
+COLS`` blocks (``q``; or ``w0, b0, w1, b1, ...`` with weights as (out, in)).
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from confront.arena.control import ControlConfig
+from confront.arena.observe import (
+    N_STATES,
+    ObservationConfig,
+    discrete_state,
+    features,
+    field_diagonal,
+    select_targets,
+)
+from confront.engine.bridge import Observation
+from confront.engine.install import EngineInstall, find_engine
+from confront.engine.java_build import compile_java
+
+ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
+POLICY_CLASSES = ("PolicyBot", "PolicyModel")
+
+
+def _rel(a: float) -> float:
+    """Angle in [-pi, pi) as (a + pi) mod 2pi - pi (confront.arena.control)."""
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+@dataclass(frozen=True)
+class ExportedPolicy:
+    """A greedy policy over the paper's observation: Q table (320 x 4) or MLP on the features."""
+
+    kind: str
+    q: np.ndarray | None = None
+    weights: tuple[np.ndarray, ...] = ()
+    biases: tuple[np.ndarray, ...] = ()
+    hidden_activation: str = "bipolar"
+    output_activation: str = "linear"
+    act_a: float = 1.725  # Eq. 19
+    act_b: float = 0.566
+    observation: ObservationConfig = field(default_factory=ObservationConfig)
+    control: ControlConfig = field(default_factory=ControlConfig)
+    step_turns: int = 1
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("qtable", "mlp"):
+            raise ValueError(f"kind must be 'qtable' or 'mlp', got {self.kind!r}")
+        if self.observation.target != "nearest":
+            raise ValueError("observation.target must be 'nearest' for export")
+        if self.step_turns < 1:
+            raise ValueError(f"step_turns must be >= 1, got {self.step_turns}")
+        if self.kind == "qtable":
+            if self.q is None or np.shape(self.q) != (N_STATES, 4) or not np.all(np.isfinite(self.q)):
+                raise ValueError(f"q must be a finite ({N_STATES}, 4) array, got shape {np.shape(self.q)}")
+        else:
+            if not self.weights or len(self.weights) != len(self.biases):
+                raise ValueError("mlp needs as many weight matrices as bias vectors (at least one)")
+            n_in = self.observation.n_features
+            for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+                if w.ndim != 2 or w.shape[1] != n_in or b.shape != (w.shape[0],):
+                    raise ValueError(f"layer {i}: weights {w.shape} / bias {b.shape} do not chain from {n_in}")
+                n_in = w.shape[0]
+            if n_in != 4:
+                raise ValueError(f"mlp must output 4 action values, got {n_in}")
+            for name in ("hidden_activation", "output_activation"):
+                if getattr(self, name) not in ACTIVATIONS:
+                    raise ValueError(f"{name} must be one of {ACTIVATIONS}, got {getattr(self, name)!r}")
+
+    # -- decisions -------------------------------------------------------------------------------
+    @staticmethod
+    def _enemies(obs: Observation) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        es = obs.enemies()
+        return (np.array([s.x for s in es]), np.array([s.y for s in es]), np.array([s.energy for s in es]))
+
+    def _activate(self, name: str, v: np.ndarray) -> np.ndarray:
+        if name == "bipolar":
+            return self.act_a * np.tanh(self.act_b * v / 2)  # Eq. 19 = a * tanh(b x / 2)
+        if name == "tanh":
+            return np.tanh(v)
+        if name == "relu":
+            return np.maximum(v, 0.0)
+        return v
+
+    def values(self, obs: Observation) -> np.ndarray:
+        """Action values of the four moves for one observation."""
+        ex, ey, ee = self._enemies(obs)
+        x = np.concatenate([[obs.x], ex])[None, :]
+        y = np.concatenate([[obs.y], ey])[None, :]
+        energy = np.concatenate([[obs.energy], ee])[None, :]
+        heading = np.full_like(x, obs.heading)
+        team = np.array([0] + [1] * len(ex))
+        # robot 0 is this tank; the others are the enemies it has seen
+        target = select_targets(x, y, energy, np.ones_like(x, dtype=bool), team, "nearest")
+        dmax = self.observation.max_distance or field_diagonal(obs.width, obs.height)
+        if self.kind == "qtable":
+            s = int(discrete_state(x, y, heading, target, dmax)[0, 0])
+            assert self.q is not None
+            return np.asarray(self.q[s], dtype=np.float64)
+        fld = (obs.width, obs.height) if self.observation.include_position else None
+        h = features(x, y, heading, energy, target, dmax, fld)[0, 0].astype(np.float64)
+        for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+            last = i == len(self.weights) - 1
+            h = self._activate(self.output_activation if last else self.hidden_activation, w @ h + b)
+        return h
+
+    def act(self, obs: Observation) -> int:
+        """Greedy move id (first maximum): 0 forward, 1 backward, 2 clockwise, 3 anticlockwise."""
+        return int(np.argmax(self.values(obs)))
+
+    def gun_radar(self, obs: Observation) -> tuple[float, float, float]:
+        """(gun turn, radar turn, fire power) of the fixed controller toward the nearest known enemy."""
+        c = self.control
+        es = obs.enemies()
+        if not es:
+            return (math.nan, 2 * math.pi, 0.0)
+        d2 = [(s.x - obs.x) ** 2 + (s.y - obs.y) ** 2 for s in es]
+        t = es[int(np.argmin(d2))]
+        dx, dy = t.x - obs.x, t.y - obs.y
+        bearing = math.atan2(dx, dy)
+        dist = math.hypot(dx, dy)
+        gun = _rel(bearing - obs.gun_heading)
+        radar = _rel(bearing - obs.radar_heading)
+        radar += math.copysign(c.radar_overshoot, radar) if radar != 0 else 0.0
+        fire = abs(gun) <= c.aim_tolerance and obs.gun_heat == 0 and obs.energy > 0 and c.fire
+        power = c.power_near if dist < c.near_distance else c.power_mid if dist < c.far_distance else c.power_far
+        return (gun, radar, power if fire else 0.0)
+
+    def __call__(self, obs: Observation) -> tuple[float, float, float, float, float]:
+        """Bridge policy with the exported robot's timing: a move every ``step_turns`` turns."""
+        ahead = turn = math.nan
+        if (obs.turn - 1) % self.step_turns == 0:
+            a = self.act(obs)
+            c = self.control
+            ahead, turn = {0: (c.move_distance, 0.0), 1: (-c.move_distance, 0.0),
+                           2: (c.turn_move_distance, c.turn_angle),
+                           3: (c.turn_move_distance, -c.turn_angle)}[a]
+        gun, radar, fire = self.gun_radar(obs)
+        return (ahead, turn, gun, radar, fire)
+
+    # -- file ----------------------------------------------------------------------------------
+    def to_text(self) -> str:
+        """The policy file read by PolicyModel.java."""
+        lines = ["confront-policy 1", f"kind {self.kind}", f"step_turns {self.step_turns}",
+                 f"target {self.observation.target}", f"max_distance {float(self.observation.max_distance or 0)!r}",
+                 f"include_position {int(self.observation.include_position)}"]
+        for f in fields(ControlConfig):
+            v = getattr(self.control, f.name)
+            lines.append(f"{f.name} {int(v) if isinstance(v, bool) else repr(float(v))}")
+
+        def matrix(name: str, a: np.ndarray) -> None:
+            a2 = np.atleast_2d(np.asarray(a, dtype=np.float64))
+            lines.append(f"matrix {name} {a2.shape[0]} {a2.shape[1]}")
+            lines.extend(" ".join(repr(float(v)) for v in row) for row in a2)
+
+        if self.kind == "qtable":
+            assert self.q is not None
+            matrix("q", self.q)
+        else:
+            lines += [f"hidden_activation {self.hidden_activation}", f"output_activation {self.output_activation}",
+                      f"act_a {self.act_a!r}", f"act_b {self.act_b!r}"]
+            for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+                matrix(f"w{i}", w)
+                matrix(f"b{i}", b[None, :])
+        return "\n".join(lines) + "\n"
+
+
+def policy_data_source(text: str, chunk: int = 30000) -> str:
+    """Java source of ``confront.PolicyData``: the policy text as string constants (each < 64 KB)."""
+    def lit(part: str) -> str:
+        return '"' + part.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+    parts = [text[i:i + chunk] for i in range(0, len(text), chunk)]
+    body = ",\n        ".join(lit(p) for p in parts)
+    return ("package confront;\n\n/** Exported policy (generated by confront.engine.export). */\n"
+            "public final class PolicyData {\n    public static final String[] CHUNKS = {\n        "
+            + body + "\n    };\n\n    private PolicyData() {\n    }\n}\n")
+
+
+def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall | None = None) -> Path:
+    """Write the standalone robot ``confront.PolicyBot`` with ``policy``: a robots folder or a ``.jar``.
+
+    A folder gets ``confront/PolicyBot.class``, ``PolicyModel.class``, ``PolicyData.class`` (the policy
+    compiled in as string constants, so the robot reads no file), ``PolicyBot.properties``, ``policy.txt``
+    and the Java sources; a jar holds the same files and can be dropped into Robocode's robots folder.
+    """
+    install = install or find_engine()
+    classes = compile_java(install)
+    out = Path(out)
+    with tempfile.TemporaryDirectory(prefix="confront-export-") as tmp:
+        root = Path(tmp) / "robot" if out.suffix == ".jar" else out
+        pkg = root / "confront"
+        pkg.mkdir(parents=True, exist_ok=True)
+        src = Path(__file__).parent / "java" / "confront"
+        for cls in POLICY_CLASSES:
+            shutil.copy2(classes / "confront" / f"{cls}.class", pkg / f"{cls}.class")
+            shutil.copy2(src / f"{cls}.java", pkg / f"{cls}.java")
+        (pkg / "PolicyBot.properties").write_text(
+            "robot.classname=confront.PolicyBot\nrobot.name=PolicyBot\nrobot.version=1.0\n"
+            "robot.description=A policy trained with confront (fuzzy RL), exported with its own inference\n"
+            "robot.java.source.included=true\nrobocode.version=1.9.3.9\n"
+        )
+        text = policy.to_text()
+        (pkg / "policy.txt").write_text(text)
+        (pkg / "PolicyData.java").write_text(policy_data_source(text))
+        proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),
+                               str(pkg / "PolicyData.java")], capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
+        if out.suffix == ".jar":
+            jar = shutil.which("jar") or str(Path(install.javac).with_name("jar"))
+            out.parent.mkdir(parents=True, exist_ok=True)
+            subprocess.run([jar, "cf", str(out.resolve()), "-C", str(root), "."], check=True,
+                           capture_output=True)
+    return out

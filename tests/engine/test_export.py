@@ -1,0 +1,131 @@
+"""Exported robots: the Java inference decides exactly like the Python policy, and plays in the engine."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import zipfile
+
+import numpy as np
+import pytest
+
+from confront.arena.observe import ObservationConfig
+from confront.engine.battle import BattleSpec
+from confront.engine.bridge import Observation, Scan, format_observation, parse_observation
+from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
+from confront.engine.export import ExportedPolicy, export_robot
+from confront.engine.java_build import compile_java
+from confront.engine.runner import EngineOptions, run_battle
+
+HELLO = {"name": "me", "team": "", "width": 800.0, "height": 600.0}
+
+
+def _q_policy(seed: int = 0) -> ExportedPolicy:
+    return ExportedPolicy("qtable", q=np.random.default_rng(seed).normal(size=(320, 4)))
+
+
+def _mlp_policy(seed: int = 1) -> ExportedPolicy:
+    rng = np.random.default_rng(seed)
+    shapes = [(16, 9), (4, 16)]
+    return ExportedPolicy(
+        "mlp", weights=tuple(rng.normal(size=s) for s in shapes), biases=tuple(rng.normal(size=s[0]) for s in shapes),
+        observation=ObservationConfig(include_position=True), step_turns=4,
+    )
+
+
+def test_q_policy_hand_computed_state() -> None:
+    q = np.zeros((320, 4))
+    # enemy straight ahead (rel bin 0) of a tank heading 100 deg (heading bin 1), 230 px away (bin 4 of 50 px)
+    q[(0 * 4 + 1) * 20 + 4] = [0.0, 0.0, 5.0, 1.0]
+    pol = ExportedPolicy("qtable", q=q)
+    h = math.radians(100)
+    me = Observation("me", (), 0, 1, 400.0, 300.0, h, 0.0, 0.0, 0.0, 100.0, 0.0, 1, 0.0, 800.0, 600.0,
+                     (Scan("e", 0, False, 0.0, 230.0, 0.0, 0.0, 50.0,
+                           400.0 + 230 * math.sin(h), 300.0 + 230 * math.cos(h)),))
+    assert pol.act(me) == 2
+    ahead, turn, gun, radar, fire = pol(me)
+    assert (ahead, turn) == (0.0, math.radians(45))
+    assert gun == pytest.approx(h) and fire == 0.0  # gun at 0 must turn to the bearing first
+    assert radar == pytest.approx(h + math.radians(20))
+
+
+def test_bad_policies_rejected() -> None:
+    with pytest.raises(ValueError, match="q must be"):
+        ExportedPolicy("qtable", q=np.zeros((10, 4)))
+    with pytest.raises(ValueError, match="kind"):
+        ExportedPolicy("tree")
+    with pytest.raises(ValueError, match="chain"):
+        ExportedPolicy("mlp", weights=(np.zeros((4, 5)),), biases=(np.zeros(4),))
+
+
+def _random_observations(n: int, seed: int) -> list[str]:
+    rng = np.random.default_rng(seed)
+    lines = []
+    for i in range(n):
+        scans = tuple(
+            Scan(f"e{k}", i, bool(k == 2), 0.0, 0.0, 0.0, 0.0, float(rng.uniform(0, 100)),
+                 float(rng.uniform(18, 782)), float(rng.uniform(18, 582)))
+            for k in range(int(rng.integers(0, 4)))
+        )
+        obs = Observation("me", (), 0, i + 1, float(rng.uniform(18, 782)), float(rng.uniform(18, 582)),
+                          float(rng.uniform(0, 2 * math.pi)), float(rng.uniform(0, 2 * math.pi)),
+                          float(rng.uniform(0, 2 * math.pi)), 0.0, float(rng.uniform(0, 100)),
+                          float(rng.choice([0.0, 0.5])), len(scans), 0.0, 800.0, 600.0, scans)
+        lines.append(format_observation(obs))
+    return lines
+
+
+def _java_decisions(install, policy: ExportedPolicy, lines: list[str], tmp_path) -> list[list[float]]:
+    classes = compile_java(install)
+    pfile = tmp_path / "policy.txt"
+    pfile.write_text(policy.to_text())
+    proc = subprocess.run([install.java, "-cp", str(classes), "confront.PolicyCheck", str(pfile), "800", "600"],
+                          input="\n".join(lines) + "\n", capture_output=True, text=True, check=True, timeout=60)
+    return [[float(v) for v in ln.split()] for ln in proc.stdout.splitlines()]
+
+
+def _compare(policy: ExportedPolicy, lines: list[str], java: list[list[float]]) -> None:
+    assert len(java) == len(lines)
+    for line, (a, gun, radar, fire) in zip(lines, java, strict=True):
+        obs = parse_observation(line, HELLO)
+        assert policy.act(obs) == int(a), line
+        pg, pr, pf = policy.gun_radar(obs)
+        assert (math.isnan(pg) and math.isnan(gun)) or gun == pytest.approx(pg, abs=1e-12)
+        assert radar == pytest.approx(pr, abs=1e-12) and fire == pf
+
+
+@pytest.mark.engine
+@pytest.mark.parametrize("make", [_q_policy, _mlp_policy], ids=["qtable", "mlp"])
+def test_java_inference_equals_python_on_random_observations(install, tmp_path, make) -> None:
+    policy = make()
+    lines = _random_observations(400, seed=5)
+    java = _java_decisions(install, policy, lines, tmp_path)
+    _compare(policy, lines, java)
+    assert len({int(r[0]) for r in java}) > 1  # the test covers more than one action
+
+
+@pytest.mark.engine
+def test_exported_robot_matches_recorded_observations_and_plays(install, tmp_path) -> None:
+    policy = _q_policy(3)
+    recorded: list[str] = []
+
+    def recording(obs: Observation):
+        recorded.append(format_observation(obs))
+        return policy(obs)
+
+    bridged = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SpinBot"), rounds=1), recording)
+    assert bridged.ok and len(recorded) > 100
+    _compare(policy, recorded, _java_decisions(install, policy, recorded, tmp_path))
+
+    jar = export_robot(policy, tmp_path / "out" / "policybot.jar", install)
+    names = set(zipfile.ZipFile(jar).namelist())
+    assert {"confront/PolicyBot.class", "confront/PolicyModel.class", "confront/PolicyData.class",
+            "confront/policy.txt", "confront/PolicyBot.properties"} <= names
+    folder = export_robot(policy, tmp_path / "robots", install)
+    for robot, extra in (("confront.PolicyBot 1.0", jar), ("confront.PolicyBot*", folder)):
+        run = run_battle(BattleSpec((robot, "SpinBot"), rounds=2), EngineOptions(seed=2), extra_robots=[extra])
+        assert not [r for r in run.summary["robot_reports"] if "policy-load-failed" in r], run.summary
+        assert not run.errors
+        me = next(r for r in run.results.contestants if r.name.startswith("confront.PolicyBot"))
+        assert me.bullet_dmg > 0  # it aims and hits with its own controller
+        assert run.results.rounds == 2

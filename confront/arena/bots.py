@@ -34,7 +34,7 @@ from numba import njit
 from .core import Arena
 from .rules import normal_absolute_angle, normal_relative_angle
 
-__all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind"]
+__all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind", "bot_battle"]
 
 BOT_NAMES = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy")
 ADVANCED_BOTS = frozenset({"SittingDuck", "SpinBot", "Crazy"})  # the others are plain Robots
@@ -527,3 +527,36 @@ class ScriptedBots:
                   s.ev_hit_by_bullet_bearing, s.ev_died, float(self.arena.scenario.width),
                   float(self.arena.scenario.height), cmd, self._rem)
         return cmd
+
+
+def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20,
+               turns_after_end: int = 150) -> tuple[np.ndarray, np.ndarray]:
+    """Free-for-all of scripted robots over ``rounds`` rounds (spread over parallel battles).
+
+    Returns the score parts (R, 6) and placements (R, 3) summed over the rounds, robot order as
+    ``names``; the score share of robot i is ``parts[i].sum() / parts.sum()``.
+    """
+    from .scenarios import get_scenario
+
+    if rounds < 1:
+        raise ValueError(f"rounds must be >= 1, got {rounds}")
+    n_battles = min(n_battles, rounds)
+    sc = get_scenario("melee").replace(teams=tuple(1 for _ in names), turns_after_end=turns_after_end,
+                                       max_turns=100000)
+    arena = Arena(sc, n_battles, seed=seed)
+    bots = ScriptedBots(arena, list(names))
+    quota = np.full(n_battles, rounds // n_battles)
+    quota[: rounds % n_battles] += 1
+    played = np.zeros(n_battles, dtype=np.int64)
+    cmd = arena.idle_commands()
+    s = arena.state
+    while (played < quota).any():
+        bots.commands(cmd)
+        arena.step(cmd)
+        done = s.done.copy()
+        if done.any():
+            played += done
+            again = done & (played < quota)
+            if again.any():
+                arena.reset(again)
+    return s.score_total.sum(axis=0), s.placements_total.sum(axis=0)

@@ -5,9 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from confront.arena.bots import BOT_NAMES, ScriptedBots
+from confront.arena.bots import BOT_NAMES, ScriptedBots, bot_battle
 from confront.arena.core import Arena
 from confront.arena.scenarios import get_scenario
+from confront.engine.install import engine_available
 
 
 def run(names, positions, turns, seed=0):
@@ -104,3 +105,26 @@ def test_unknown_bot_name():
     arena = Arena("1v1", 1)
     with pytest.raises(ValueError, match="unknown bot"):
         ScriptedBots(arena, ["SpinBot", "Nope"])
+
+
+def test_bot_battle_counts_rounds():
+    parts, places = bot_battle(["Walls", "SittingDuck"], rounds=5, n_battles=2, turns_after_end=0)
+    assert places[:, 0].sum() == 5  # one first per round
+    assert parts[0].sum() > parts[1].sum()
+
+
+@pytest.mark.engine
+@pytest.mark.slow
+@pytest.mark.skipif(not engine_available(), reason="needs the real Robocode engine")
+@pytest.mark.parametrize("pair", [("SpinBot", "Walls"), ("Tracker", "RamFire")])
+def test_score_shares_match_the_real_engine(pair):
+    """Small version of the 100-round comparison: shares within 8 points after 20 rounds each."""
+    from confront.engine.battle import BattleSpec
+    from confront.engine.runner import EngineOptions, run_battle
+
+    run = run_battle(BattleSpec(contestants=pair, rounds=20), EngineOptions(seed=1))
+    eng = {r.name.split(".")[-1]: r.total for r in run.results.contestants}
+    eng_share = eng[pair[0]] / sum(eng.values())
+    parts, _ = bot_battle(list(pair), rounds=40, seed=1)
+    sim_share = parts[0].sum() / parts.sum()
+    assert abs(sim_share - eng_share) < 0.08, (sim_share, eng_share)

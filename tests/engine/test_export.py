@@ -129,3 +129,15 @@ def test_exported_robot_matches_recorded_observations_and_plays(install, tmp_pat
         me = next(r for r in run.results.contestants if r.name.startswith("confront.PolicyBot"))
         assert me.bullet_dmg > 0  # it aims and hits with its own controller
         assert run.results.rounds == 2
+
+
+@pytest.mark.engine
+def test_evaluate_exported_policy_in_engine(install) -> None:
+    from confront.engine.evaluate import evaluate_policy
+
+    res, ratio = evaluate_policy(_q_policy(4), "1v1", "SittingDuck", rounds=1, seed=1)
+    ours = next(r for r in res.contestants if r.name.startswith("confront.PolicyBot"))
+    assert ratio == pytest.approx(ours.total / sum(r.total for r in res.contestants))
+    assert ours.firsts == 1 and ratio > 0.5  # SittingDuck never shoots
+    with pytest.raises(ValueError, match="mode"):
+        evaluate_policy(_q_policy(4), "1v1", "SittingDuck", mode="jpype")

@@ -9,16 +9,16 @@ import java.nio.charset.StandardCharsets;
 import java.util.LinkedHashMap;
 import java.util.Map;
 
-import robocode.AdvancedRobot;
 import robocode.RobotDeathEvent;
 import robocode.ScannedRobotEvent;
+import robocode.TeamRobot;
 
 /**
  * A trained policy exported from confront, running with no Python: reads its policy (compiled into
  * confront.PolicyData at export, so no file access is needed in the sandbox or from a jar), picks one of the paper's four moves every step_turns turns from the latest
- * scans, and runs the fixed gun/radar controller every turn.
+ * scans of enemies (team-mates are ignored), and runs the fixed gun/radar controller every turn.
  */
-public class PolicyBot extends AdvancedRobot {
+public class PolicyBot extends TeamRobot {
     private final Map<String, double[]> enemies = new LinkedHashMap<>();
 
     @Override
@@ -91,17 +91,12 @@ public class PolicyBot extends AdvancedRobot {
 
     @Override
     public void onScannedRobot(ScannedRobotEvent e) {
-        if (isTeammateName(e.getName())) {
+        if (isTeammate(e.getName())) {
             return;
         }
         double abs = getHeadingRadians() + e.getBearingRadians();
         enemies.put(e.getName(), new double[] {getX() + e.getDistance() * Math.sin(abs),
                 getY() + e.getDistance() * Math.cos(abs), e.getEnergy()});
-    }
-
-    /** Plain AdvancedRobots have no team-mates. */
-    protected boolean isTeammateName(String name) {
-        return false;
     }
 
     @Override

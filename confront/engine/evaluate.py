@@ -1,0 +1,54 @@
+"""Playing an exported policy in the real engine against sample robots (what ``confront evaluate
+--engine robocode`` needs): either as the standalone PolicyBot (no Python) or through the bridge."""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+from confront.engine.battle import BattleSpec, scenario_battle
+from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
+from confront.engine.export import ExportedPolicy, export_robot
+from confront.engine.results import BattleResults
+from confront.engine.runner import EngineOptions, run_battle
+
+MODES = ("export", "bridge")
+
+
+def evaluate_policy(
+    policy: ExportedPolicy,
+    scenario: str,
+    opponents: str | Sequence[str],
+    rounds: int = 100,
+    seed: int = 0,
+    mode: str = "export",
+    cpu_constant_ms: float = 10.0,
+) -> tuple[BattleResults, float]:
+    """Play ``policy`` for our side of ``scenario`` and return (results, our score ratio).
+
+    ``mode="export"`` plays the compiled PolicyBot (no Python in the loop); ``"bridge"`` lets the Python
+    twin decide every turn through the bridge. Both decide identically on identical observations.
+    """
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
+    opts = EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms)
+    if mode == "bridge":
+        spec = scenario_battle(scenario, BRIDGE_BOT.rstrip("*"), opponents, rounds=rounds)
+        spec = _single_star(spec, BRIDGE_BOT)
+        res = run_bridged_battle(spec, policy, opts).run.results
+    else:
+        with tempfile.TemporaryDirectory(prefix="confront-eval-") as tmp:
+            folder = export_robot(policy, Path(tmp) / "robots")
+            spec = _single_star(scenario_battle(scenario, "confront.PolicyBot", opponents, rounds=rounds),
+                                "confront.PolicyBot*")
+            res = run_battle(spec, opts, extra_robots=[folder]).results
+    ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))
+    return res, res.score_ratio(ours.name)
+
+
+def _single_star(spec: BattleSpec, starred: str) -> BattleSpec:
+    """A single loose-class robot is selected by its starred name; team files use the plain name."""
+    plain = starred.rstrip("*")
+    conts = tuple(starred if c == plain else c for c in spec.contestants)
+    return BattleSpec(conts, rounds=spec.rounds, width=spec.width, height=spec.height, name=spec.name)

@@ -6,7 +6,7 @@ import dataclasses
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -18,6 +18,7 @@ __all__ = [
     "check_int",
     "check_range",
     "params_from_dict",
+    "require_keys",
 ]
 
 
@@ -157,7 +158,8 @@ def params_from_dict(cls: type[LearnerParams], values: dict[str, Any]) -> Learne
 class Learner(ABC):
     """One interface for every learner (see docs/architecture.md, "Learners")."""
 
-    kind: ClassVar[str] = ""
+    kind: str  # the factory kind that builds this learner
+    params: Any  # its typed parameter dataclass
     observation: str  # "discrete" or "features"
     n_actions: int
 

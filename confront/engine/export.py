@@ -32,7 +32,7 @@ from confront.engine.install import EngineInstall, find_engine
 from confront.engine.java_build import compile_java
 
 ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
-POLICY_CLASSES = ("PolicyBot", "PolicyModel")
+POLICY_CLASSES = ("PolicyBot", "PolicyModel", "RoundStart")
 
 
 def _rel(a: float) -> float:

@@ -18,6 +18,8 @@ from confront.engine.install import EngineInstall
 JAVA_SOURCES = Path(__file__).parent / "java"
 # Robot classes (package confront) and their robot.name entries for the .properties files.
 ROBOT_CLASSES: tuple[str, ...] = ("ScriptBot", "BridgeBot")
+# helper classes the robots load at run time, copied next to them
+ROBOT_HELPERS: tuple[str, ...] = ("RoundStart",)
 
 
 def cache_root() -> Path:

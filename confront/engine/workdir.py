@@ -8,7 +8,7 @@ from pathlib import Path
 
 from confront.engine.battle import TEAM_PACKAGE, Team
 from confront.engine.install import EngineInstall
-from confront.engine.java_build import ROBOT_CLASSES
+from confront.engine.java_build import ROBOT_CLASSES, ROBOT_HELPERS
 
 SAMPLE_PACKAGES: tuple[str, ...] = ("sample", "sampleteam")
 
@@ -42,6 +42,8 @@ def prepare_workdir(
             shutil.copytree(install.samples / pkg, robots / pkg)
     ours = robots / "confront"
     ours.mkdir(exist_ok=True)
+    for helper in ROBOT_HELPERS:
+        shutil.copy2(classes / "confront" / f"{helper}.class", ours / f"{helper}.class")
     for cls in ROBOT_CLASSES:
         for f in (classes / "confront").glob(f"{cls}*.class"):
             if f.stem == cls or f.stem.startswith(cls + "$"):

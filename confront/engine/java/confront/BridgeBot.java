@@ -56,8 +56,8 @@ public class BridgeBot extends TeamRobot {
         setAdjustGunForRobotTurn(true);
         setAdjustRadarForRobotTurn(true);
         setAdjustRadarForGunTurn(true);
-        // act once before connecting: the engine waits for each robot's first action at round start, and
-        // a slow first action often costs the full wait there (lost wake-up in RobotPeer.startRound)
+        // act once before connecting, after giving the engine time to wait for this first action
+        RoundStart.awaitEngine();
         execute();
         connect();
         int every = Integer.parseInt(System.getProperty("confront.bridge.every", "1"));

@@ -26,6 +26,7 @@ public class PolicyBot extends TeamRobot {
         setAdjustGunForRobotTurn(true);
         setAdjustRadarForRobotTurn(true);
         setAdjustRadarForGunTurn(true);
+        RoundStart.awaitEngine();
         PolicyModel model;
         try {
             model = load();

@@ -57,7 +57,7 @@ TEAM, EVROBOT, EVHITBY, EVBHIT, EVMISSED = range(len(RI_FIELDS))
 RNG, TIME, ROUND, INACT, ENDT, NB = range(len(BI_FIELDS))
 (INACT_E,) = range(len(BF_FIELDS))
 DECIDED, DONE = range(len(BB_FIELDS))
-KX, KY, KLX, KLY, KH, KP = range(len(KF_FIELDS))
+KX, KY, KLX, KLY, KH, KP, KVX, KVY = range(len(KF_FIELDS))
 KOWNER, KVICTIM, KSTATE, KFRAME, KLIST, KLINE = range(len(KI_FIELDS))
 # score parts and placements
 S_SURV, S_LAST, S_BDMG, S_BKILL, S_RAM, S_RKILL = range(6)
@@ -146,6 +146,9 @@ def _add_list_entry(kf, ki, bi, b, state, owner, x, y, power, heading, victim):
     kf[b, KLY, slot] = y
     kf[b, KH, slot] = heading
     kf[b, KP, slot] = power
+    sp = bullet_speed(power)
+    kf[b, KVX, slot] = sp * math.sin(heading)  # the engine's per-turn step v*sin(h), v*cos(h): constant
+    kf[b, KVY, slot] = sp * math.cos(heading)
     ki[b, KOWNER, slot] = owner
     ki[b, KVICTIM, slot] = victim
     ki[b, KSTATE, slot] = state
@@ -222,9 +225,8 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
         # movement along the heading at 20 - 3p
         kf[b, KLX, s] = kf[b, KX, s]
         kf[b, KLY, s] = kf[b, KY, s]
-        sp = bullet_speed(kf[b, KP, s])
-        kf[b, KX, s] += sp * math.sin(kf[b, KH, s])
-        kf[b, KY, s] += sp * math.cos(kf[b, KH, s])
+        kf[b, KX, s] += kf[b, KVX, s]
+        kf[b, KY, s] += kf[b, KVY, s]
         ki[b, KLINE, s] = 1
         x = kf[b, KX, s]
         y = kf[b, KY, s]
@@ -241,7 +243,9 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
         if st == B_FIRED or st == B_MOVING:
             cand = 0
             for j in range(n):
-                if j != owner and rb[b, ALIVE, j] and \
+                # the segment is at most 19.7 long: boxes farther than 18 + 20 from its end cannot be hit
+                if j != owner and rb[b, ALIVE, j] and abs(rf[b, BX, j] - x) < 38.0 and \
+                        abs(rf[b, BY, j] - y) < 38.0 and \
                         segment_intersects_box(lx, ly, x, y, rf[b, BX, j], rf[b, BY, j]):
                     cand += 1
             if cand >= 2:
@@ -284,6 +288,9 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
             cand = 0
             for q in range(nbk):
                 s2 = ki[b, KLIST, q]
+                # segments of at most 19.7 whose start points are 40 apart cannot cross
+                if abs(kf[b, KLX, s2] - lx) >= 40.0 or abs(kf[b, KLY, s2] - ly) >= 40.0:
+                    continue
                 st2 = ki[b, KSTATE, s2]
                 if s2 != s and (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KLINE, s2] != 0 and \
                         ki[b, KOWNER, s2] != owner and segments_intersect(

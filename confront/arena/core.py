@@ -51,7 +51,8 @@ the deciding turn, as Robocode does), parts in :data:`confront.arena.state.SCORE
 ``placements`` / ``placements_total`` ``(B, R, 3)`` 1sts, 2nds, 3rds.
 
 Bullets ``(B, K)``: Robocode's bullet list, slots ``b_list[b, :n_bullets]`` in list order:
-``b_x``, ``b_y``, ``b_last_x``, ``b_last_y``, ``b_heading``, ``b_power``, ``b_owner``,
+``b_x``, ``b_y``, ``b_last_x``, ``b_last_y``, ``b_heading``, ``b_power``, ``b_vx``, ``b_vy`` (step per
+turn), ``b_owner``,
 ``b_victim``, ``b_state`` (0 free, 1 fired, 2 moving, 3 hit robot, 4 hit bullet, 5 hit wall,
 6 robot explosion), ``b_frame``, ``b_has_line``.
 

@@ -37,7 +37,7 @@ RI_FIELDS = ("team", "ev_hit_robot", "ev_hit_by_bullet", "ev_bullet_hit", "ev_bu
 BI_FIELDS = ("rng", "time", "round", "inactive_turns", "end_timer", "n_bullets")
 BF_FIELDS = ("inactivity_energy",)
 BB_FIELDS = ("decided", "done")
-KF_FIELDS = ("b_x", "b_y", "b_last_x", "b_last_y", "b_heading", "b_power")
+KF_FIELDS = ("b_x", "b_y", "b_last_x", "b_last_y", "b_heading", "b_power", "b_vx", "b_vy")
 KI_FIELDS = ("b_owner", "b_victim", "b_state", "b_frame", "b_list", "b_has_line")
 
 # group: (fields, shape kind, dtype)

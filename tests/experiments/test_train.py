@@ -1,0 +1,109 @@
+"""Training runs: run-folder layout, repeatability, kill-and-resume equality, refusal of corrupt checkpoints."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+SMALL = ["--set", "train.rounds=48", "--set", "train.session_rounds=8", "--set", "train.checkpoint_every=8",
+         "--set", "arena.battles=4", "--set", "opponent.pretrain_rounds=8", "--set", "train.replay=false"]
+
+
+def _env(tmp_path: Path) -> dict[str, str]:
+    return {**os.environ, "CONFRONT_CACHE": str(tmp_path / "cache")}
+
+
+def _train(tmp_path: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "confront.cli.main", "train", "-c", "demo", "--quiet",
+                           "--out", str(out), *SMALL, *extra], capture_output=True, text=True, env=_env(tmp_path),
+                          timeout=600)
+
+
+def _rows(run: Path, name: str = "rounds") -> list[dict[str, str]]:
+    with (run / "metrics" / f"{name}.csv").open() as fh:
+        return list(csv.DictReader(fh))
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    tmp = tmp_path_factory.mktemp("ref")
+    proc = _train(tmp, tmp / "ref")
+    assert proc.returncode == 0, proc.stderr
+    return tmp, tmp / "ref"
+
+
+def test_run_folder_layout(reference: tuple[Path, Path]) -> None:
+    _, run = reference
+    names = {p.name for p in run.iterdir()}
+    assert {"config.toml", "metrics", "plots", "checkpoints", "model", "summary.json"} <= names
+    assert {p.name for p in (run / "metrics").iterdir()} >= {"rounds.csv", "sessions.csv"}
+    assert {p.name for p in (run / "plots").iterdir()} >= {"score_ratio.png", "scores.png", "defensive.png"}
+    rows, sessions = _rows(run), _rows(run, "sessions")
+    assert [int(r["round"]) for r in rows] == list(range(1, 49))
+    assert len(sessions) == 6
+    for r in rows:  # score ratio is ours / (ours + theirs) and the parts add up to the totals
+        o, t = float(r["score_ours"]), float(r["score_theirs"])
+        assert float(r["score_ratio"]) == pytest.approx(o / (o + t))
+        parts = ("survival", "last_survivor", "bullet_damage", "bullet_kill_bonus", "ram_damage", "ram_kill_bonus")
+        assert sum(float(r[f"{p}_ours"]) for p in parts) == pytest.approx(o)
+    first = sessions[0]
+    chunk = rows[:8]
+    assert float(first["score_ours"]) == pytest.approx(sum(float(r["score_ours"]) for r in chunk))
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["rounds"] == 48 and 0.0 <= summary["final_score_ratio"] <= 1.0
+    assert (run / "model" / "model.npz").exists() and (run / "model" / "model.json").exists()
+
+
+def test_same_seed_same_metrics_other_seed_differs(reference: tuple[Path, Path], tmp_path: Path) -> None:
+    tmp, ref = reference
+    again = _train(tmp, tmp_path / "again")
+    assert again.returncode == 0, again.stderr
+    assert _rows(tmp_path / "again") == _rows(ref)
+    other = _train(tmp, tmp_path / "other", "--seed", "1")
+    assert other.returncode == 0, other.stderr
+    assert _rows(tmp_path / "other") != _rows(ref)
+
+
+def test_sigkill_then_resume_equals_uninterrupted(reference: tuple[Path, Path], tmp_path: Path) -> None:
+    tmp, ref = reference
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([sys.executable, "-m", "confront.cli.main", "train", "-c", "demo", "--quiet",
+                             "--out", str(out), *SMALL], env=_env(tmp), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    deadline = time.time() + 300
+    while time.time() < deadline and not (out / "checkpoints" / "LATEST").exists():
+        time.sleep(0.01)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL
+    assert not (out / "summary.json").exists(), "the run finished before it could be killed"
+    resumed = subprocess.run([sys.executable, "-m", "confront.cli.main", "train", "--resume", str(out), "--quiet"],
+                             capture_output=True, text=True, env=_env(tmp), timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    assert _rows(out) == _rows(ref)
+    assert _rows(out, "sessions") == _rows(ref, "sessions")
+
+
+def test_corrupt_checkpoint_is_refused_and_kept(reference: tuple[Path, Path], tmp_path: Path) -> None:
+    tmp, _ = reference
+    out = tmp_path / "corrupt"
+    proc = _train(tmp, out)
+    assert proc.returncode == 0
+    (out / "summary.json").unlink()
+    latest = out / "checkpoints" / (out / "checkpoints" / "LATEST").read_text().strip()
+    npz = latest / "state.npz"
+    npz.write_bytes(npz.read_bytes()[: npz.stat().st_size // 2])
+    before = sorted((p.name, p.stat().st_size) for p in (out / "checkpoints").rglob("*"))
+    resumed = subprocess.run([sys.executable, "-m", "confront.cli.main", "train", "--resume", str(out), "--quiet"],
+                             capture_output=True, text=True, env=_env(tmp), timeout=600)
+    assert resumed.returncode == 2
+    assert "corrupt or truncated" in resumed.stderr and "Traceback" not in resumed.stderr
+    assert sorted((p.name, p.stat().st_size) for p in (out / "checkpoints").rglob("*")) == before

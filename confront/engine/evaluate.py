@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from confront.engine.battle import BattleSpec, scenario_battle
-from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
+from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.results import BattleResults
 from confront.engine.runner import EngineOptions, run_battle
@@ -23,16 +23,18 @@ def evaluate_policy(
     rounds: int = 100,
     seed: int = 0,
     mode: str = "export",
-    cpu_constant_ms: float = 10.0,
+    cpu_constant_ms: float | None = None,
 ) -> tuple[BattleResults, float]:
     """Play ``policy`` for our side of ``scenario`` and return (results, our score ratio).
 
     ``mode="export"`` plays the compiled PolicyBot (no Python in the loop); ``"bridge"`` lets the Python
     twin decide every turn through the bridge. Both decide identically on identical observations.
+    ``cpu_constant_ms`` defaults to 30 ms for the bridge (no skipped turns) and 10 ms for the export.
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
-    opts = EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms)
+    cpu = cpu_constant_ms or (BRIDGE_CPU_CONSTANT_MS if mode == "bridge" else 10.0)
+    opts = EngineOptions(seed=seed, cpu_constant_ms=cpu)
     if mode == "bridge":
         spec = scenario_battle(scenario, BRIDGE_BOT.rstrip("*"), opponents, rounds=rounds)
         spec = _single_star(spec, BRIDGE_BOT)

@@ -61,7 +61,7 @@ def test_stalling_python_falls_back(install) -> None:
             time.sleep(0.4)  # twice the robot's 200 ms patience
         return nearest_enemy_policy(obs)
 
-    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=3), policy)
+    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=3), policy, timeout_ms=200)
     round0 = [f for f in res.failures if "round=0" in f]
     assert len(round0) == 1 and "turn=39" in round0[0] and "SocketTimeoutException" in round0[0]
     assert max(t for r, t in seen if r == 0) == 40  # no decisions after the stall

@@ -176,12 +176,24 @@ class TeamBattleEnv:
 
     def reset(self, seed: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Start new battles (totals cleared; reseeded when ``seed`` is given): (discrete, features)."""
+        # a new battle has fresh robots: no boxes left from the last round constrain the placement
+        self.arena.state.box_x[...] = np.nan
+        self.arena.state.box_y[...] = np.nan
         if seed is not None:
             self.arena.seed(seed)
         self.arena.new_battle()
         if self.bots is not None:
             self.bots.reset()
             self.bots._round[:] = self.arena.state.round
+        target, disc, feats = self.observe()
+        self._last = (target, disc, feats)
+        return disc, feats
+
+    def restart(self, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Start a new round in the masked battles (B,) now; the unfinished round scores nothing more."""
+        m = np.asarray(mask, dtype=bool)
+        if m.any():
+            self.arena.reset(m)  # scripted bots clear their memory on the new round themselves
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats

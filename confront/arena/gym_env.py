@@ -1,0 +1,170 @@
+"""Gymnasium environment ``confront/Battle-v0``: one learning tank (robot 0) against opponents.
+
+``gymnasium.make("confront/Battle-v0", scenario="1v1", opponents="SpinBot", turns_per_step=10)``.
+
+- Observation: ``Dict(state=Discrete(320), features=Box(F,))`` - the paper's discrete state and the
+  continuous features of :mod:`confront.arena.observe` (sin/cos relative angle, sin/cos heading,
+  distance/diagonal, own and target energy / 100, optionally x/W, y/H).
+- Action: ``Discrete(4)`` (forward, backward, clockwise, anticlockwise) or ``Discrete(12)`` with
+  ``fire_power_actions=True`` (action = power_index * 4 + move, powers 1, 2, 3), held for T turns.
+- Reward: the sum of the T per-turn Eq. 35 rewards (``info["rewards"]`` has the T values).
+- Episode: one round. ``terminated`` when the tank dies or the round is decided, ``truncated`` when the
+  round reaches ``max_turns``. ``info["score"]``: the tank's score parts this round (Robocode's six, in
+  ``info["score_parts"]`` order); at the end also ``info["team_score"]`` (teams x 6).
+- Other learning tanks (team-mates, ``opponents="td"``) act by ``other_policy(discrete, features, rng)``
+  returning (B, R) actions; without one they pick uniformly random moves (an untrained team).
+- ``render_mode="rgb_array"`` draws the battle with :mod:`confront.arena.render`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from .observe import N_STATES
+from .render import FrameData, draw_frame
+from .scenarios import Scenario, get_scenario
+from .smdp import SMDPConfig, StepResult, TeamBattleEnv
+from .state import SCORE_PARTS
+
+__all__ = ["BattleEnv", "AgentDriver", "make_observation_space", "make_config", "OtherPolicy", "ENV_ID"]
+
+ENV_ID = "confront/Battle-v0"
+OtherPolicy = Callable[[np.ndarray, np.ndarray, np.random.Generator], np.ndarray]
+
+
+def make_config(turns_per_step: int = 10, fire_power_actions: bool = False, config: SMDPConfig | None = None,
+                **kwargs: Any) -> SMDPConfig:
+    """An SMDPConfig from keyword arguments (or the one given)."""
+    if config is not None:
+        return config
+    return SMDPConfig(turns_per_step=turns_per_step, fire_power_actions=fire_power_actions, **kwargs)
+
+
+def make_observation_space(n_features: int) -> spaces.Dict:
+    """Dict of the discrete state and the feature vector (energy / 100 bounded by 10: 1000 energy)."""
+    low = np.array([-1, -1, -1, -1, 0, 0, 0, 0, 0][:n_features], dtype=np.float32)
+    high = np.array([1, 1, 1, 1, 1, 10, 10, 1, 1][:n_features], dtype=np.float32)
+    return spaces.Dict({"state": spaces.Discrete(N_STATES), "features": spaces.Box(low, high, dtype=np.float32)})
+
+
+class AgentDriver:
+    """A TeamBattleEnv seen from some agents (robot indices); other learning tanks act by a policy."""
+
+    def __init__(self, scenario: Scenario | str, n_battles: int, seed: int, opponents: Any,
+                 config: SMDPConfig, agents: list[int] | None, other_policy: OtherPolicy | None) -> None:
+        sc = get_scenario(scenario) if isinstance(scenario, str) else scenario
+        self.env = TeamBattleEnv(sc, n_battles, seed=seed, opponents=opponents,
+                                 config=dataclasses.replace(config, auto_reset=False))
+        self.agents = np.asarray([0] if agents is None else agents, dtype=np.int64)
+        if not self.env.learner[self.agents].all():
+            raise ValueError(f"agents {self.agents.tolist()} must be learning tanks (team 0 or 'td' opponents)")
+        self.others = np.flatnonzero(self.env.learner & ~np.isin(np.arange(self.env.n_robots), self.agents))
+        self.other_policy = other_policy
+        self._full = np.zeros((n_battles, self.env.n_robots), dtype=np.int64)
+
+    def full_actions(self, agent_actions: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """(B, R) actions: the agents' (B, n_agents) plus the other learning tanks'."""
+        a = self._full
+        if self.others.size:
+            if self.other_policy is None:
+                a[:, self.others] = rng.integers(0, self.env.n_actions, size=(a.shape[0], self.others.size))
+            else:
+                disc, feats = self.env._last[1], self.env._last[2]  # type: ignore[index]
+                a[:, self.others] = np.asarray(self.other_policy(disc, feats, rng))[:, self.others]
+        a[:, self.agents] = agent_actions
+        return a
+
+    def team_score(self) -> np.ndarray:
+        """(B, teams, 6) this round's score parts per team."""
+        s = self.env.arena.state
+        team = self.env.team
+        return np.stack([s.score[:, team == k].sum(axis=1) for k in range(self.env.scenario.n_teams)], axis=1)
+
+    def frame(self, b: int = 0) -> FrameData:
+        """What battle b shows now."""
+        s = self.env.arena.state
+        k = int(s.n_bullets[b])
+        slots = s.b_list[b, :k]
+        live = np.isin(s.b_state[b, slots], (1, 2))
+        sl = slots[live]
+        bullets = np.stack([s.b_x[b, sl], s.b_y[b, sl], s.b_power[b, sl]], axis=-1)
+        return FrameData(s.x[b], s.y[b], s.heading[b], s.gun_heading[b], s.radar_heading[b], s.energy[b],
+                         s.alive[b], self.env.team, bullets, s.score[b].sum(axis=-1),
+                         f"round {int(s.round[b])}  turn {int(s.time[b])}")
+
+
+class BattleEnv(gym.Env):
+    """One learning tank against opponents in the batched arena (a batch of one)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(self, scenario: Scenario | str = "1v1", opponents: Any = None, turns_per_step: int = 10,
+                 fire_power_actions: bool = False, config: SMDPConfig | None = None,
+                 other_policy: OtherPolicy | None = None, render_mode: str | None = None,
+                 render_scale: float = 0.5, seed: int = 0, order: str = "engine") -> None:
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        cfg = make_config(turns_per_step, fire_power_actions, config)
+        sc = get_scenario(scenario) if isinstance(scenario, str) else scenario
+        self._driver = AgentDriver(sc, 1, seed, opponents, cfg, [0], other_policy)
+        self.render_mode = render_mode
+        self.render_scale = render_scale
+        self.observation_space = make_observation_space(cfg.observation.n_features)
+        self.action_space = spaces.Discrete(cfg.n_actions)
+        self._base_seed = seed
+
+    @property
+    def team_env(self) -> TeamBattleEnv:
+        """The underlying batched SMDP environment."""
+        return self._driver.env
+
+    def _obs(self, disc: np.ndarray, feats: np.ndarray) -> dict[str, Any]:
+        return {"state": int(disc[0, 0]), "features": feats[0, 0].copy()}
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[dict[str, Any], dict[str, Any]]:
+        """Start a new round (a new battle, reseeded, when ``seed`` is given)."""
+        super().reset(seed=seed)
+        env = self._driver.env
+        if seed is not None:
+            disc, feats = env.reset(seed=seed)
+        else:
+            disc, feats = env.restart(np.ones(1, dtype=bool))
+        return self._obs(disc, feats), {"score_parts": SCORE_PARTS}
+
+    def step(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
+        """Hold the action for T turns."""
+        if not self.action_space.contains(action):
+            raise ValueError(f"action must be in 0..{self.action_space.n - 1}, got {action!r}")
+        drv = self._driver
+        res: StepResult = drv.env.step(drv.full_actions(np.array([[int(action)]]), self.np_random))
+        rewards = res.rewards[0, 0]
+        terminated = bool(res.terminated[0, 0] and not res.truncated[0])
+        truncated = bool(res.truncated[0])
+        info: dict[str, Any] = {"rewards": rewards, "score": drv.env.arena.state.score[0, 0].copy(),
+                                "score_parts": SCORE_PARTS}
+        if terminated or truncated:
+            info["team_score"] = drv.team_score()[0]
+        return self._obs(res.discrete, res.features), float(rewards.sum()), terminated, truncated, info
+
+    def render(self) -> np.ndarray | None:
+        """An RGB frame (rgb_array mode)."""
+        if self.render_mode != "rgb_array":
+            return None
+        sc = self._driver.env.scenario
+        return draw_frame(self._driver.frame(0), sc.width, sc.height, self.render_scale)
+
+
+def register() -> None:
+    """Register ``confront/Battle-v0`` with Gymnasium (idempotent)."""
+    if ENV_ID not in gym.registry:
+        gym.register(id=ENV_ID, entry_point="confront.arena.gym_env:BattleEnv")
+
+
+register()

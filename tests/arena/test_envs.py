@@ -1,0 +1,107 @@
+"""Gymnasium env, vector env and PettingZoo env: official checkers plus value checks."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test, parallel_seed_test
+
+from confront.arena import gym_env  # noqa: F401 - registers confront/Battle-v0
+from confront.arena.pz_env import parallel_env
+from confront.arena.vector_env import BattleVectorEnv
+
+
+def test_gym_check_env_and_registration() -> None:
+    env = gym.make("confront/Battle-v0", scenario="1v1", opponents="SpinBot")
+    check_env(env.unwrapped, skip_render_check=True)
+    env12 = gym.make("confront/Battle-v0", scenario="4v4", opponents="Walls", fire_power_actions=True)
+    check_env(env12.unwrapped, skip_render_check=True)
+    assert env12.action_space.n == 12
+
+
+def test_gym_episode_reward_is_sum_of_turn_rewards_and_ends_with_scores() -> None:
+    env = gym.make("confront/Battle-v0", scenario="1v1", opponents="SpinBot", turns_per_step=7)
+    obs, _ = env.reset(seed=4)
+    assert 0 <= obs["state"] < 320 and obs["features"].shape == (7,)
+    for _ in range(2000):
+        obs, r, term, trunc, info = env.step(0)
+        assert info["rewards"].shape == (7,)
+        assert r == pytest.approx(float(info["rewards"].sum()))
+        if term or trunc:
+            break
+    assert term or trunc
+    ts = info["team_score"]
+    assert ts.shape == (2, 6)
+    # one tank died: the survivor's team got 50 survival and 10 last-survivor bonus (1 enemy)
+    assert sorted(ts[:, 0].tolist()) == [0.0, 50.0]
+    assert sorted(ts[:, 1].tolist()) == [0.0, 10.0]
+
+
+def test_gym_reset_seed_repeats() -> None:
+    env = gym.make("confront/Battle-v0", scenario="1v1", opponents="Crazy")
+    o1, _ = env.reset(seed=11)
+    r1 = [env.step(a)[1] for a in (0, 2, 1, 3, 0)]
+    o2, _ = env.reset(seed=11)
+    r2 = [env.step(a)[1] for a in (0, 2, 1, 3, 0)]
+    assert o1["state"] == o2["state"] and r1 == r2
+
+
+def test_gym_render_shows_tanks() -> None:
+    env = gym.make("confront/Battle-v0", scenario="1v1", opponents="SittingDuck", render_mode="rgb_array")
+    env.reset(seed=0)
+    img = env.render()
+    assert img.shape == (300, 400, 3) and img.dtype == np.uint8
+    s = env.unwrapped.team_env.arena.state
+    for r, colour in ((0, (66, 135, 245)), (1, (230, 70, 60))):
+        # 8 px behind the centre along the body heading (= gun heading at the start): body colour
+        h = s.heading[0, r]
+        x, y = s.x[0, r] - 8 * np.sin(h), s.y[0, r] - 8 * np.cos(h)
+        px = img[int((600 - y) * 0.5), int(x * 0.5)]
+        assert tuple(px) == colour
+
+
+def test_vector_env_batches_natively() -> None:
+    v = BattleVectorEnv(6, "1v1", "SpinBot", turns_per_step=5, seed=3)
+    assert v.unwrapped._driver.env.n_battles == 6
+    obs, _ = v.reset(seed=3)
+    assert obs["state"].shape == (6,) and obs["features"].shape == (6, 7)
+    ended = 0
+    for _ in range(600):
+        obs, r, term, trunc, info = v.step(np.zeros(6, dtype=np.int64))
+        assert r.shape == term.shape == trunc.shape == (6,)
+        if "final_obs" in info:
+            m = info["_final_obs"]
+            ended += int(m.sum())
+            assert all(info["final_obs"][i] is not None for i in np.flatnonzero(m))
+            # the ended battles restarted this step: full energy in the new round's observation
+            assert np.all(obs["features"][m, 5] == 1.0)
+        if ended >= 2:
+            break
+    assert ended >= 2
+
+
+def test_vector_env_matches_single_env() -> None:
+    v = BattleVectorEnv(1, "1v1", "Walls", seed=9)
+    e = gym.make("confront/Battle-v0", scenario="1v1", opponents="Walls")
+    ov, _ = v.reset(seed=9)
+    oe, _ = e.reset(seed=9)
+    for a in (0, 1, 2, 3, 0, 0):
+        ov, rv, *_ = v.step(np.array([a]))
+        oe, re, *_ = e.step(a)
+        assert int(ov["state"][0]) == oe["state"] and rv[0] == pytest.approx(re)
+
+
+def test_pettingzoo_api_and_seed() -> None:
+    parallel_api_test(parallel_env(scenario="4v4", opponents="SpinBot"), num_cycles=100)
+    parallel_api_test(parallel_env(scenario="4v4"), num_cycles=60)  # td opponents acting at random
+    parallel_seed_test(lambda: parallel_env(scenario="4v4", opponents="td"), num_cycles=60)
+
+
+def test_pettingzoo_agents_and_bad_action() -> None:
+    env = parallel_env(scenario="4v6", opponents="SittingDuck")
+    obs, _ = env.reset(seed=1)
+    assert env.agents == ["tank_0", "tank_1", "tank_2", "tank_3"] and set(obs) == set(env.agents)
+    with pytest.raises(ValueError, match="tank_0"):
+        env.step({"tank_0": 7})
+    with pytest.raises(ValueError, match="unknown agent"):
+        env.step({"tank_9": 0})

@@ -55,6 +55,7 @@ class ExportedPolicy:
     observation: ObservationConfig = field(default_factory=ObservationConfig)
     control: ControlConfig = field(default_factory=ControlConfig)
     step_turns: int = 1
+    inputs: str = "features"  # mlp input: the continuous features, or "onehot" of the discrete state
 
     def __post_init__(self) -> None:
         if self.kind not in ("qtable", "mlp"):
@@ -63,13 +64,15 @@ class ExportedPolicy:
             raise ValueError("observation.target must be 'nearest' for export")
         if self.step_turns < 1:
             raise ValueError(f"step_turns must be >= 1, got {self.step_turns}")
+        if self.inputs not in ("features", "onehot"):
+            raise ValueError(f"inputs must be 'features' or 'onehot', got {self.inputs!r}")
         if self.kind == "qtable":
             if self.q is None or np.shape(self.q) != (N_STATES, 4) or not np.all(np.isfinite(self.q)):
                 raise ValueError(f"q must be a finite ({N_STATES}, 4) array, got shape {np.shape(self.q)}")
         else:
             if not self.weights or len(self.weights) != len(self.biases):
                 raise ValueError("mlp needs as many weight matrices as bias vectors (at least one)")
-            n_in = self.observation.n_features
+            n_in = self.observation.n_features if self.inputs == "features" else N_STATES
             for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
                 if w.ndim != 2 or w.shape[1] != n_in or b.shape != (w.shape[0],):
                     raise ValueError(f"layer {i}: weights {w.shape} / bias {b.shape} do not chain from {n_in}")
@@ -79,6 +82,34 @@ class ExportedPolicy:
             for name in ("hidden_activation", "output_activation"):
                 if getattr(self, name) not in ACTIVATIONS:
                     raise ValueError(f"{name} must be one of {ACTIVATIONS}, got {getattr(self, name)!r}")
+
+    @classmethod
+    def from_learner(
+        cls,
+        learner: object,
+        observation: ObservationConfig | None = None,
+        control: ControlConfig | None = None,
+        step_turns: int = 1,
+    ) -> ExportedPolicy:
+        """The greedy policy of a trained learner: a tabular Q learner (``state_dict()["q"]``, 320 x 4) or a
+        DMNN (weights ``w0, b0, ...`` stored (in, out), bipolar hidden layers, linear or bipolar output)."""
+        state = learner.state_dict()  # type: ignore[attr-defined]
+        obs_cfg = observation or ObservationConfig()
+        ctl = control or ControlConfig()
+        if "q" in state:
+            return cls("qtable", q=np.asarray(state["q"], dtype=np.float64), observation=obs_cfg, control=ctl,
+                       step_turns=step_turns)
+        n = sum(1 for k in state if k.startswith("w") and k[1:].isdigit())
+        if n == 0:
+            raise ValueError(f"learner state has neither 'q' nor 'w0': keys {sorted(state)}")
+        p = learner.params  # type: ignore[attr-defined]
+        return cls(
+            "mlp", weights=tuple(np.asarray(state[f"w{i}"], dtype=np.float64).T for i in range(n)),
+            biases=tuple(np.asarray(state[f"b{i}"], dtype=np.float64) for i in range(n)),
+            hidden_activation="bipolar", output_activation=p.output, act_a=p.a, act_b=p.b,
+            observation=obs_cfg, control=ctl, step_turns=step_turns,
+            inputs="onehot" if learner.observation == "discrete" else "features",  # type: ignore[attr-defined]
+        )
 
     # -- decisions -------------------------------------------------------------------------------
     @staticmethod
@@ -95,23 +126,41 @@ class ExportedPolicy:
             return np.maximum(v, 0.0)
         return v
 
-    def values(self, obs: Observation) -> np.ndarray:
-        """Action values of the four moves for one observation."""
+    def state_and_features(self, obs: Observation) -> tuple[int, np.ndarray]:
+        """The paper's discrete state and the continuous features of one bridge observation, built with
+        ``confront.arena.observe`` (this tank is robot 0, the enemies it has seen are the others)."""
         ex, ey, ee = self._enemies(obs)
         x = np.concatenate([[obs.x], ex])[None, :]
         y = np.concatenate([[obs.y], ey])[None, :]
         energy = np.concatenate([[obs.energy], ee])[None, :]
         heading = np.full_like(x, obs.heading)
         team = np.array([0] + [1] * len(ex))
-        # robot 0 is this tank; the others are the enemies it has seen
         target = select_targets(x, y, energy, np.ones_like(x, dtype=bool), team, "nearest")
         dmax = self.observation.max_distance or field_diagonal(obs.width, obs.height)
-        if self.kind == "qtable":
-            s = int(discrete_state(x, y, heading, target, dmax)[0, 0])
-            assert self.q is not None
-            return np.asarray(self.q[s], dtype=np.float64)
+        state = int(discrete_state(x, y, heading, target, dmax)[0, 0])
         fld = (obs.width, obs.height) if self.observation.include_position else None
-        h = features(x, y, heading, energy, target, dmax, fld)[0, 0].astype(np.float64)
+        return state, features(x, y, heading, energy, target, dmax, fld)[0, 0]
+
+    def learner_observation(self, obs: Observation, kind: str) -> np.ndarray:
+        """What a learner with ``observation`` = ``kind`` ("discrete" or "features") sees, as a batch of 1."""
+        state, feats = self.state_and_features(obs)
+        if kind == "discrete":
+            return np.array([state], dtype=np.int64)
+        if kind == "features":
+            return feats[None, :].astype(np.float64)
+        raise ValueError(f"observation kind must be 'discrete' or 'features', got {kind!r}")
+
+    def values(self, obs: Observation) -> np.ndarray:
+        """Action values of the four moves for one observation."""
+        state, feats = self.state_and_features(obs)
+        if self.kind == "qtable":
+            assert self.q is not None
+            return np.asarray(self.q[state], dtype=np.float64)
+        if self.inputs == "onehot":
+            h = np.zeros(N_STATES)
+            h[state] = 1.0
+        else:
+            h = feats.astype(np.float64)
         for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
             last = i == len(self.weights) - 1
             h = self._activate(self.output_activation if last else self.hidden_activation, w @ h + b)
@@ -170,7 +219,8 @@ class ExportedPolicy:
             assert self.q is not None
             matrix("q", self.q)
         else:
-            lines += [f"hidden_activation {self.hidden_activation}", f"output_activation {self.output_activation}",
+            lines += [f"inputs {self.inputs}", f"hidden_activation {self.hidden_activation}",
+                      f"output_activation {self.output_activation}",
                       f"act_a {self.act_a!r}", f"act_b {self.act_b!r}"]
             for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
                 matrix(f"w{i}", w)

@@ -141,3 +141,41 @@ def test_evaluate_exported_policy_in_engine(install) -> None:
     assert ours.firsts == 1 and ratio > 0.5  # SittingDuck never shoots
     with pytest.raises(ValueError, match="mode"):
         evaluate_policy(_q_policy(4), "1v1", "SittingDuck", mode="jpype")
+
+
+def _trained_like(kind: str):
+    from confront.learning.dmnn import DMNN, DMNNParams
+    from confront.learning.tabular import TabularQ
+
+    if kind == "tabular":
+        learner = TabularQ()
+        learner.q = np.random.default_rng(7).normal(size=(320, 4))
+        return learner
+    if kind == "dmnn_features":
+        return DMNN(DMNNParams(n_inputs=7, hidden=(12,), observation="features", q_scale=3.0, init_seed=2))
+    return DMNN(DMNNParams(n_inputs=320, hidden=(8,), observation="discrete", output="bipolar", init_seed=3))
+
+
+@pytest.mark.parametrize("kind", ["tabular", "dmnn_features", "dmnn_discrete"])
+def test_policy_from_learner_decides_like_the_learner(kind: str) -> None:
+    learner = _trained_like(kind)
+    policy = ExportedPolicy.from_learner(learner)
+    rng = np.random.default_rng(0)
+    acts = set()
+    for line in _random_observations(150, seed=11):
+        obs = parse_observation(line, HELLO)
+        x = policy.learner_observation(obs, learner.observation)
+        q = learner.q_values(x)[0] if hasattr(learner, "q_values") else learner.q[x[0]]
+        scale = getattr(learner.params, "q_scale", 1.0)
+        np.testing.assert_allclose(policy.values(obs) * scale, q, rtol=1e-12, atol=1e-12)
+        a = policy.act(obs)
+        assert a == int(learner.act(x, rng, explore=False)[0])
+        acts.add(a)
+    assert len(acts) > 1
+
+
+@pytest.mark.engine
+def test_java_inference_equals_python_for_onehot_dmnn(install, tmp_path) -> None:
+    policy = ExportedPolicy.from_learner(_trained_like("dmnn_discrete"))
+    lines = _random_observations(200, seed=9)
+    _compare(policy, lines, _java_decisions(install, policy, lines, tmp_path))

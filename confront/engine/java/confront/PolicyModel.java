@@ -204,8 +204,15 @@ public final class PolicyModel {
         }
         int t = nearest(x, y, ex, ey);
         double dmax = maxDistance(width, height);
-        double[] v = values(state(x, y, heading, t, ex, ey, dmax),
-                q != null ? null : features(x, y, heading, energy, t, ex, ey, ee, dmax, width, height));
+        int s = state(x, y, heading, t, ex, ey, dmax);
+        double[] in = null;
+        if (q == null && "onehot".equals(keys.get("inputs"))) {
+            in = new double[320];
+            in[s] = 1.0;
+        } else if (q == null) {
+            in = features(x, y, heading, energy, t, ex, ey, ee, dmax, width, height);
+        }
+        double[] v = values(s, in);
         int best = 0;
         for (int i = 1; i < v.length; i++) {
             if (v[i] > v[best]) {

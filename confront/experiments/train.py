@@ -153,8 +153,10 @@ def _round_row(end: Any, b: int, team: np.ndarray) -> dict[str, Any]:
 class Loop:
     """The SMDP interaction loop over a TeamBattleEnv; state is data so it can be checkpointed."""
 
-    def __init__(self, env: TeamBattleEnv, side: Side, seed: int, transfer: tuple[float, float, float] | None = None):
+    def __init__(self, env: TeamBattleEnv, side: Side, seed: int, transfer: tuple[float, float, float] | None = None,
+                 learning: bool = True) -> None:
         self.env, self.side = env, side
+        self.learning = learning  # False: evaluate greedily, nothing learns
         self.team = env.team_ids()
         self.rngs = {name: np.random.default_rng([seed, i]) for i, name in enumerate(("act", "opp", "tf"))}
         self.transfer = transfer
@@ -198,7 +200,7 @@ class Loop:
         actions = np.zeros((b, r), dtype=np.int64)
         obs_ours = _obs(side.learner, self.disc, self.feats)[:, side.ours]
         flat = obs_ours.reshape((-1,) + obs_ours.shape[2:])
-        ours_a = side.learner.act(flat, self.rngs["act"]).reshape(b, -1)
+        ours_a = side.learner.act(flat, self.rngs["act"], explore=self.learning).reshape(b, -1)
         if side.source is not None and self.transfer is not None:
             eps = transfer_epsilon(self.rounds_done, *self.transfer)
             use_source = self.rngs["tf"].random(ours_a.shape) < eps
@@ -210,12 +212,13 @@ class Loop:
         if side.opponent is not None and side.theirs is not None:
             obs_t = _obs(side.opponent, self.disc, self.feats)[:, side.theirs]
             their_a = side.opponent.act(obs_t.reshape((-1,) + obs_t.shape[2:]), self.rngs["opp"],
-                                        explore=side.opponent_learns)
+                                        explore=side.opponent_learns and self.learning)
             actions[:, side.theirs] = their_a.reshape(b, -1)
         res = env.step(actions)
         self.decisions += 1
-        self._learn(side.learner, side.ours, res, actions)
-        if side.opponent is not None and side.opponent_learns and side.theirs is not None:
+        if self.learning:
+            self._learn(side.learner, side.ours, res, actions)
+        if self.learning and side.opponent is not None and side.opponent_learns and side.theirs is not None:
             self._learn(side.opponent, side.theirs, res, actions)
         ended: list[dict[str, Any]] = []
         if res.round_end is not None:

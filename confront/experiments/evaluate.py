@@ -1,0 +1,232 @@
+"""Evaluating, exporting, replaying and battling: the commands that use a trained model or scripted robots."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from confront.arena.smdp import TeamBattleEnv
+from confront.config import load_toml
+from confront.engine.results import BattleResults, ScoreRow
+from confront.experiments.spec import ExperimentConfig, config_from_dict
+from confront.experiments.train import Loop, Side, _run, load_model, scenario_of, smdp_config
+from confront.learning.base import Learner
+from confront.learning.dmnn import DMNN
+
+PARTS = ("survival", "last_survivor", "bullet_damage", "bullet_kill_bonus", "ram_damage", "ram_kill_bonus")
+
+
+def _run_config(run: Path) -> ExperimentConfig:
+    if not (run / "config.toml").exists():
+        raise FileNotFoundError(f"{run} is not a run folder (no config.toml)")
+    return config_from_dict(load_toml(run / "config.toml"))
+
+
+def results_from_rows(rows: list[dict[str, Any]], names: tuple[str, str]) -> BattleResults:
+    """Team-level score table (Robocode's columns) from per-round rows of a simulator run."""
+    out = []
+    for side, name in zip(("ours", "theirs"), names, strict=True):
+        parts = {p: sum(float(r[f"{p}_{side}"]) for r in rows) for p in PARTS}
+        wins = sum(1 for r in rows if (r["won"] if side == "ours" else (r["decided"] and not r["won"])))
+        out.append(ScoreRow(name, sum(parts.values()), parts["survival"], parts["last_survivor"],
+                            parts["bullet_damage"], parts["bullet_kill_bonus"], parts["ram_damage"],
+                            parts["ram_kill_bonus"], firsts=wins, seconds=len(rows) - wins, team=name))
+    out.sort(key=lambda r: -r.total)
+    return BattleResults(rounds=max(1, len(rows)), contestants=tuple(out), engine="sim")
+
+
+def sim_evaluate(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seed: int,
+                 td_model: str | None = None, battles: int = 16) -> list[dict[str, Any]]:
+    """Play ``learner`` greedily (no exploration, no learning) against ``opponent`` in the simulator."""
+    env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=min(battles, rounds), seed=seed,
+                        opponents=opponent, config=smdp_config(cfg))
+    team = env.team_ids()
+    side = Side(learner, ours=team == 0)
+    if opponent == "td":
+        if not td_model:
+            raise FileNotFoundError("evaluating against the TD team needs the run's TD model (summary.json td_model)")
+        side.opponent, _ = load_model(td_model)
+        side.theirs = team != 0
+    loop = Loop(env, side, seed=seed, learning=False)
+    _run(loop, rounds, progress=False, desc="evaluate")
+    return loop.rows[:rounds]
+
+
+def exported_policy(learner: Learner, cfg: ExperimentConfig) -> Any:
+    """The learner as the engine's ExportedPolicy (the same greedy decisions, in Java or through the bridge)."""
+    from confront.engine.export import ExportedPolicy
+
+    if cfg.arena.fire_power_actions:
+        raise click.UsageError("export supports the paper's four moves only (arena.fire_power_actions = false)")
+    if isinstance(learner, DMNN):
+        p = learner.params
+        return ExportedPolicy("mlp", weights=tuple(w.T.copy() for w in learner.weights),
+                              biases=tuple(b.copy() for b in learner.biases), hidden_activation="bipolar",
+                              output_activation="linear" if p.output == "linear" else "bipolar", act_a=p.a,
+                              act_b=p.b, step_turns=cfg.arena.decision_turns)
+    q = getattr(learner, "q", None)
+    if q is None:
+        raise click.UsageError(f"cannot export a {learner.kind} learner")
+    return ExportedPolicy("qtable", q=np.asarray(q), step_turns=cfg.arena.decision_turns)
+
+
+def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int) -> None:
+    cfg = _run_config(run)
+    learner, _ = load_model(run)
+    summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
+    names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
+    lines = ["| opponent | rounds | score ratio (simulator) | score ratio (robocode) | difference |",
+             "|---|---:|---:|---:|---:|"]
+    for name in names:
+        rows = sim_evaluate(cfg, learner, name, rounds, seed, summary.get("td_model"))
+        sim = results_from_rows(rows, ("ours", name))
+        sim_ratio = sim.score_ratio("ours")
+        click.echo(f"\n{name} in the simulator ({rounds} rounds):\n{sim.to_markdown()}")
+        real = ""
+        diff = ""
+        if engine == "robocode":
+            if name == "td":
+                raise click.UsageError("the TD team is not available in the real engine: pass --opponents "
+                                       "SpinBot,Walls,Tracker,RamFire")
+            from confront.engine.evaluate import evaluate_policy
+
+            res, ratio = evaluate_policy(exported_policy(learner, cfg), cfg.arena.scenario, name, rounds=rounds,
+                                         seed=seed)
+            click.echo(f"{name} in Robocode ({rounds} rounds, {res.skipped_turns} skipped turns):\n"
+                       f"{res.to_markdown()}")
+            real, diff = f"{ratio:.3f}", f"{ratio - sim_ratio:+.3f}"
+        lines.append(f"| {name} | {rounds} | {sim_ratio:.3f} | {real} | {diff} |")
+    click.echo("\n" + "\n".join(lines))
+
+
+def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int) -> BattleResults:
+    """Scripted robots in the simulator: one name per team (a team is filled with copies of its robot)."""
+    from confront.arena.bots import ScriptedBots
+    from confront.arena.core import Arena
+
+    sc = scenario_of(scenario)
+    if len(robots) != len(sc.teams):
+        raise click.UsageError(f"scenario {sc.name} has {len(sc.teams)} teams: give {len(sc.teams)} robots, "
+                               f"got {','.join(robots)}")
+    per_robot = [robots[t] for t in sc.team_ids()]
+    n = min(16, rounds)
+    arena = Arena(sc.replace(turns_after_end=150, max_turns=100000), n, seed=seed)
+    bots = ScriptedBots(arena, per_robot)
+    quota = np.full(n, rounds // n)
+    quota[: rounds % n] += 1
+    played = np.zeros(n, dtype=np.int64)
+    cmd = arena.idle_commands()
+    s = arena.state
+    while (played < quota).any():
+        bots.commands(cmd)
+        arena.step(cmd)
+        if s.done.any():
+            played += s.done
+            again = s.done & (played < quota)
+            if again.any():
+                arena.reset(again)
+    team = np.asarray(sc.team_ids())
+    totals = s.score_total.sum(axis=0)
+    places = s.placements_total.sum(axis=0)
+    rows = []
+    for k, name in enumerate(robots):
+        parts = totals[team == k].sum(axis=0)
+        pl = places[team == k].sum(axis=0) if sc.teams[k] == 1 else places[team == k][0]
+        label = name if len(sc.teams) > 1 and sc.teams[k] == 1 else f"{name} team {k}"
+        rows.append(ScoreRow(label, float(parts.sum()), *map(float, parts), firsts=int(pl[0]), seconds=int(pl[1]),
+                             thirds=int(pl[2]), team=label))
+    rows.sort(key=lambda r: -r.total)
+    return BattleResults(rounds=rounds, contestants=tuple(rows), engine="sim")
+
+
+def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed: int,
+               replay_out: Path | None) -> None:
+    sc = scenario_of(scenario)
+    from confront.arena.bots import BOT_NAMES
+
+    default = [("SpinBot", "Walls", "Tracker", "RamFire", "Crazy", "Fire", "Corners", "SittingDuck")[i % 8]
+               for i in range(len(sc.teams))]
+    names = [r.strip() for r in robots.split(",")] if robots else default
+    for n in names:
+        if n not in BOT_NAMES:
+            raise click.UsageError(f"unknown robot {n!r}: use {', '.join(BOT_NAMES)}")
+    if engine == "robocode":
+        from confront.engine.runner import run_scenario
+
+        if len(names) != 2:
+            raise click.UsageError("--engine robocode battles take two sides: --robots OURS,THEIRS")
+        run = run_scenario(sc.name, names[0], names[1], rounds=rounds, seed=seed)
+        click.echo(f"Robocode, {sc.name}, {rounds} rounds ({run.turns} turns, {run.elapsed_s:.1f} s, "
+                   f"{sum(run.skipped_turns.values())} skipped turns):\n{run.results.to_markdown()}")
+        return
+    res = sim_bot_battle(sc.name if not scenario.endswith(".toml") else scenario, names, rounds, seed)
+    click.echo(f"simulator, {sc.name}, {rounds} rounds:\n{res.to_markdown()}")
+    if replay_out is not None:
+        click.echo("(replays of scripted battles: use `confront replay` on a training run's replays/)")
+
+
+def export_cli(run: Path, out: Path, name: str | None) -> None:
+    from confront.engine.export import export_robot
+
+    cfg = _run_config(run)
+    learner, _ = load_model(run)
+    folder = export_robot(exported_policy(learner, cfg), out)
+    click.echo(f"wrote the robot confront.PolicyBot to {folder}: copy it into Robocode's robots folder "
+               "(no Python needed to run it)")
+
+
+def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | None = None) -> str | None:
+    """One greedy round of the trained team in a single fresh battle, as replay JSON + GIF + HTML."""
+    from confront.arena import replay as rp
+
+    env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=1,
+                        seed=cfg.train.seed + 1000 if seed is None else seed,
+                        opponents="td" if side.opponent is not None else cfg.opponent.kind,
+                        config=smdp_config(cfg))
+    if not hasattr(env, "record"):
+        return None
+    loop = Loop(env, Side(side.learner, side.ours, side.opponent, side.theirs), seed=cfg.train.seed, learning=False)
+    replay = env.record(0)
+    while loop.rounds_done < 1:
+        loop.step()
+    env.record(None)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    path = replay.save(out_dir / "last_round.json")
+    rp.write_gif(replay, out_dir / "last_round.gif")
+    rp.write_html(replay, out_dir / "last_round.html", title=f"confront: {cfg.name}")
+    return str(path)
+
+
+def replay_cli(source: Path, out: Path | None) -> None:
+    from confront.arena import replay as rp
+
+    files = sorted(source.glob("replays/*.json")) + sorted(source.glob("*.json")) if source.is_dir() else [source]
+    files = [f for f in files if f.name != "summary.json"]
+    if not files:
+        raise FileNotFoundError(f"no replay files in {source}")
+    for f in files:
+        replay = rp.load_replay(f)
+        stem = out if (out is not None and len(files) == 1) else f.with_suffix("")
+        gif = rp.write_gif(replay, Path(f"{stem}.gif"))
+        page = rp.write_html(replay, Path(f"{stem}.html"))
+        click.echo(f"{f}: {len(replay)} frames -> {gif}, {page}")
+
+
+BENCHES = {"sim": "sim_throughput.py", "learner": "learner_throughput.py", "env": "env_throughput.py",
+           "bridge": "bridge_throughput.py", "reproduce": "reproduce_time.py"}
+
+
+def bench_cli(what: str) -> None:
+    root = Path(__file__).resolve().parents[2] / "benchmarks"
+    if not root.is_dir():
+        raise FileNotFoundError("benchmarks/ is not here: run `confront bench` from a source checkout")
+    for key in (BENCHES if what == "all" else [what]):
+        script = root / BENCHES[key]
+        click.echo(f"== {script.name}")
+        subprocess.run([sys.executable, str(script)], check=False)

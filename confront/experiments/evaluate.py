@@ -17,7 +17,6 @@ from confront.engine.results import BattleResults, ScoreRow
 from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.experiments.train import Loop, Side, _run, load_model, scenario_of, smdp_config
 from confront.learning.base import Learner
-from confront.learning.dmnn import DMNN
 
 PARTS = ("survival", "last_survivor", "bullet_damage", "bullet_kill_bonus", "ram_damage", "ram_kill_bonus")
 
@@ -64,16 +63,8 @@ def exported_policy(learner: Learner, cfg: ExperimentConfig) -> Any:
 
     if cfg.arena.fire_power_actions:
         raise click.UsageError("export supports the paper's four moves only (arena.fire_power_actions = false)")
-    if isinstance(learner, DMNN):
-        p = learner.params
-        return ExportedPolicy("mlp", weights=tuple(w.T.copy() for w in learner.weights),
-                              biases=tuple(b.copy() for b in learner.biases), hidden_activation="bipolar",
-                              output_activation="linear" if p.output == "linear" else "bipolar", act_a=p.a,
-                              act_b=p.b, step_turns=cfg.arena.decision_turns)
-    q = getattr(learner, "q", None)
-    if q is None:
-        raise click.UsageError(f"cannot export a {learner.kind} learner")
-    return ExportedPolicy("qtable", q=np.asarray(q), step_turns=cfg.arena.decision_turns)
+    return ExportedPolicy.from_learner(learner, observation=smdp_config(cfg).observation,
+                                       step_turns=cfg.arena.decision_turns)
 
 
 def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int) -> None:

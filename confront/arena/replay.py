@@ -175,6 +175,27 @@ class Replay:
         return p
 
 
+def record_frame(replay: Replay, arena: Any, b: int = 0) -> None:
+    """Append battle b's current state of an :class:`confront.arena.core.Arena` to ``replay``."""
+    s = arena.state
+    k = int(s.n_bullets[b])
+    slots = s.b_list[b, :k]
+    sl = slots[np.isin(s.b_state[b, slots], (1, 2))]  # fired or moving
+    replay.add(turn=int(s.time[b]), round=int(s.round[b]), x=s.x[b], y=s.y[b], heading=s.heading[b],
+               gun_heading=s.gun_heading[b], radar_heading=s.radar_heading[b], energy=s.energy[b],
+               alive=s.alive[b], bullets=np.stack([s.b_x[b, sl], s.b_y[b, sl], s.b_power[b, sl]], axis=-1),
+               scores=s.score_total[b].sum(axis=-1) + s.score[b].sum(axis=-1) * ~s.decided[b])
+
+
+def new_replay(arena: Any, names: list[str] | None = None) -> Replay:
+    """An empty replay for an Arena's scenario (robot names default to ``team<t>.<i>``)."""
+    sc = arena.scenario
+    teams = sc.team_ids()
+    if names is None:
+        names = [f"team{t}.{i}" for i, t in enumerate(teams)]
+    return Replay(float(sc.width), float(sc.height), list(names), teams, scenario=sc.name, scores=None)
+
+
 def load_replay(path: str | Path) -> Replay:
     """Read a replay file (.json or .json.gz)."""
     p = Path(path)

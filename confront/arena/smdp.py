@@ -30,6 +30,7 @@ from .bots import BOT_NAMES, ScriptedBots
 from .control import N_MOVES, ControlConfig, gun_radar_commands, move_commands, set_adjustments
 from .core import Arena
 from .observe import ObservationConfig, field_diagonal, gather_target, observe, reward_eq35, select_targets
+from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
 from .state import SCORE_PARTS
 
@@ -141,6 +142,7 @@ class TeamBattleEnv:
         self._cmd = self.arena.idle_commands()
         self._powers = np.asarray(self.config.fire_powers, dtype=np.float64)
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._recording: tuple[Replay, int] | None = None
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -198,6 +200,22 @@ class TeamBattleEnv:
         self._last = (target, disc, feats)
         return disc, feats
 
+    def start_recording(self, battle: int = 0, names: list[str] | None = None) -> Replay:
+        """Record battle ``battle`` turn by turn into a new :class:`Replay` (until stop_recording)."""
+        if not 0 <= battle < self.n_battles:
+            raise ValueError(f"battle must be in 0..{self.n_battles - 1}, got {battle}")
+        if names is None:
+            names = [f"{d or 'learner'}.{i}" for i, d in enumerate(self.drivers)]
+        rep = new_replay(self.arena, names)
+        record_frame(rep, self.arena, battle)
+        self._recording = (rep, battle)
+        return rep
+
+    def stop_recording(self) -> Replay | None:
+        """Stop recording; the replay recorded so far."""
+        rec, self._recording = self._recording, None
+        return None if rec is None else rec[0]
+
     # ------------------------------------------------------------------ stepping
     def _check_actions(self, actions: np.ndarray) -> np.ndarray:
         a = np.asarray(actions)
@@ -240,6 +258,8 @@ class TeamBattleEnv:
             self.arena.step(cmd)
             r = reward_eq35(own_prev, s.energy, tgt_prev, gather_target(s.energy, target), guard)
             rewards[:, :, t] = np.where(live & (target >= 0), r, 0.0)
+            if self._recording is not None:
+                record_frame(self._recording[0], self.arena, self._recording[1])
             if s.done.all():
                 break
         return self._finish(rewards, active)

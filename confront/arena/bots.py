@@ -506,9 +506,20 @@ class ScriptedBots:
         self.mem[idx] = 0.0
         self.mem[idx, :, M_STATIC:] = keep
         self.mem[idx, :, M_TARGET] = -1.0
-        s = self.arena.state
-        bots = self.kinds != K_NONE
-        s.max_velocity[idx] = np.where(bots[None, :], 8.0, s.max_velocity[idx])
+        self._round[idx] = self.arena.state.round[idx]
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """The bots' memory (data only), for checkpoints next to ``Arena.state_dict``."""
+        return {"mem": self.mem.copy(), "round": self._round.copy()}
+
+    def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
+        """Restore what :meth:`state_dict` wrote."""
+        for key, dst in (("mem", self.mem), ("round", self._round)):
+            if key not in d:
+                raise ValueError(f"bots state dict lacks {key!r}")
+            if np.shape(d[key]) != dst.shape:
+                raise ValueError(f"bots state {key!r} has shape {np.shape(d[key])}, expected {dst.shape}")
+            dst[...] = d[key]
 
     def commands(self, cmd: np.ndarray) -> np.ndarray:
         """Fill the scripted robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""

@@ -128,3 +128,29 @@ def test_score_shares_match_the_real_engine(pair):
     parts, _ = bot_battle(list(pair), rounds=40, seed=1)
     sim_share = parts[0].sum() / parts.sum()
     assert abs(sim_share - eng_share) < 0.08, (sim_share, eng_share)
+
+
+def test_bots_state_dict_round_trip():
+    sc = get_scenario("melee").replace(teams=(1, 1, 1, 1))
+    names = ["SpinBot", "Walls", "Tracker", "Fire"]
+    a = Arena(sc, 3, seed=4)
+    bots = ScriptedBots(a, names)
+    cmd = a.idle_commands()
+    for _ in range(80):
+        bots.commands(cmd)
+        a.step(cmd)
+    saved, saved_bots = a.state_dict(), bots.state_dict()
+    ref = []
+    for _ in range(80):
+        bots.commands(cmd)
+        a.step(cmd)
+        ref.append(a.state.x.copy())
+    b = Arena(sc, 3, seed=0)
+    b.load_state_dict(saved)
+    bots2 = ScriptedBots(b, names)
+    bots2.load_state_dict(saved_bots)
+    cmd2 = b.idle_commands()
+    for x in ref:
+        bots2.commands(cmd2)
+        b.step(cmd2)
+        np.testing.assert_array_equal(b.state.x, x)

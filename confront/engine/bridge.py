@@ -265,6 +265,9 @@ class BridgeServer:
                     elif line.startswith("E "):
                         with self._lock:
                             self.stats.rounds_ended += 1
+                            end = getattr(self.policy, "end_episode", None)
+                            if end is not None:  # e.g. a learner's last SMDP step of the round
+                                end(hello["name"], int(line.split(" ")[1]))
                     else:
                         obs = parse_observation(line, hello)
                         with self._lock:

@@ -7,7 +7,9 @@ error E_p = phi^2 / 2 (Eq. 21) is averaged over the batch (Eq. 22). "With AWM": 
 adaptive rate 1 - exp(-E_p) per pattern (Eq. 24); "without AWM": plain back-propagation at a fixed rate.
 
 The output layer is linear by default (Q is unbounded; the paper's bipolar output would cap it at +-a): choose
-``output="bipolar"`` for Eq. 20 as printed, with ``q_scale`` mapping Q to network units (Q = q_scale * y).
+``output="bipolar"`` for Eq. 20 as printed. Targets are scaled into network units, Q = q_scale * y, and the TD
+error is clipped to +-td_clip network units before Eq. 32 (0 disables it): the adaptive rate 1 - exp(-E) tends
+to 1 for large errors and, with momentum 0.95, would otherwise take twenty-fold steps and diverge.
 Parameter sharing (§4.2) is simply a batch whose rows are the tanks of a team: one network, one update.
 """
 
@@ -125,7 +127,8 @@ class DMNNParams(LearnerParams):
     a: float = 1.725
     b: float = 0.566
     output: str = "linear"
-    q_scale: float = 1.0
+    q_scale: float = 10.0
+    td_clip: float = 5.0
     gamma: float = 0.9
     alpha: float = 0.1
     rate: str = "fixed"
@@ -154,6 +157,7 @@ class DMNNParams(LearnerParams):
         check_range("b", self.b, 0.0, 1e6, lo_open=True)
         check_choice("output", self.output, OUTPUTS)
         check_range("q_scale", self.q_scale, 0.0, 1e12, lo_open=True)
+        check_range("td_clip", self.td_clip, 0.0, 1e12)
         check_range("gamma", self.gamma, 0.0, 1.0)
         check_range("alpha", self.alpha, 0.0, 1.0, lo_open=True)
         check_choice("rate", self.rate, RATES)
@@ -242,7 +246,8 @@ class DMNN(Learner):
         rows = np.arange(n)
         td = target - acts[-1][rows, a]
         alpha = self.learning_rate(batch.rewards)
-        phi = alpha * td  # Eq. 32: phi_t = Q_next - Q_cur = alpha [target - Q_cur]
+        clipped = np.clip(td, -p.td_clip, p.td_clip) if p.td_clip > 0 else td  # guard: see docs/learning.md
+        phi = alpha * clipped  # Eq. 32: phi_t = Q_next - Q_cur = alpha [target - Q_cur]
         e_p = 0.5 * phi * phi  # Eq. 21: E_p = (O - y)^2 / 2 with the label O = Q_cur + phi
         if p.awm:
             lam = 1.0 - np.exp(-e_p)  # Eq. 24: adaptive rate 1 - exp(-E_p)
@@ -260,6 +265,8 @@ class DMNN(Learner):
             self.vel_b[i] -= gb[i]
             self.weights[i] += self.vel_w[i]
             self.biases[i] += self.vel_b[i]
+        if not all(np.isfinite(w).all() for w in self.weights):
+            raise FloatingPointError("DMNN weights became non-finite: lower td_clip or raise q_scale")
         self.step += 1
         self._last = np.array([np.abs(td).mean() * p.q_scale, alpha.mean(), lam.mean(), e_p.mean()])
         return {"td_error": float(self._last[0]), "learning_rate": float(self._last[1]),

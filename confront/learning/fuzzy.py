@@ -17,7 +17,6 @@ from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
-import skfuzzy
 
 from confront.learning.base import check_int
 
@@ -67,6 +66,8 @@ def _corners(points: np.ndarray) -> list[list[float]]:
 
 def memberships(x: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Degrees of the five terms at ``x`` (clipped to the domain), with skfuzzy: ``(5, len(x))``."""
+    import skfuzzy  # imported here: it pulls in scipy, which other learners do not need
+
     x = np.clip(np.atleast_1d(np.asarray(x, dtype=np.float64)), points[0], points[-1])
     rows = []
     for c in _corners(points):
@@ -103,6 +104,8 @@ def _infer_numpy(r: np.ndarray, params: FuzzyParams) -> np.ndarray:
 
 def _infer_skfuzzy(r: np.ndarray, params: FuzzyParams) -> np.ndarray:
     """Eq. 12-17 with skfuzzy's memberships and max-min composition."""
+    import skfuzzy
+
     ip = np.asarray(params.input_points)
     op = np.asarray(params.output_points)
     idm = memberships(ip, ip)  # Eq. 12

@@ -54,7 +54,8 @@ def _bandit(x, a, q):
 
 
 def test_adaptive_rate_and_momentum_eq23_eq24():
-    net = make_learner("dmnn", n_inputs=2, n_actions=2, hidden=(3,), alpha=0.5, momentum=0.95)
+    net = make_learner("dmnn", n_inputs=2, n_actions=2, hidden=(3,), alpha=0.5, momentum=0.95,
+                       q_scale=1.0, td_clip=0.0)
     x = np.array([[0.5, -1.0], [1.0, 2.0]])
     a = np.array([0, 1])
     targets = np.array([[3.0, 0.0], [0.0, -2.0]])
@@ -79,7 +80,8 @@ def test_adaptive_rate_and_momentum_eq23_eq24():
 
 
 def test_without_awm_is_plain_backprop_at_fixed_rate():
-    net = make_learner("dmnn", n_inputs=2, n_actions=2, hidden=(3,), alpha=0.5, awm=False, nn_rate=0.9)
+    net = make_learner("dmnn", n_inputs=2, n_actions=2, hidden=(3,), alpha=0.5, awm=False, nn_rate=0.9,
+                       q_scale=1.0)
     x = np.array([[0.5, -1.0]])
     a = np.array([1])
     w0 = [w.copy() for w in net.weights]
@@ -113,6 +115,20 @@ def test_dmnn_fits_a_known_q_function(awm, output, q_scale):
     assert rmse < 0.25 * np.std(q_star(x))
     greedy = net.act(x, rng, explore=False)
     assert np.mean(greedy == q_star(x).argmax(axis=1)) > 0.85
+
+
+def test_td_error_is_clipped_and_scaled():
+    net = make_learner("dmnn", n_inputs=1, n_actions=1, hidden=(2,), alpha=0.5, awm=False, nn_rate=0.1,
+                       q_scale=10.0, td_clip=1.0)
+    net.weights[-1][:] = 0.0
+    net.biases[-1][:] = 0.0
+    x = np.zeros((1, 1))
+    before = net.weights[-1].copy()
+    h = forward(net.weights, net.biases, x, A, B, True)[1]
+    net.learn(Transition(x, np.array([0]), np.array([[1000.0]]), x, np.array([True])))
+    # td = 1000 / 10 = 100 network units, clipped to 1, phi = 0.5; step = 0.1 * phi * h
+    assert np.allclose(net.weights[-1] - before, 0.1 * 0.5 * h.T)
+    assert net.diagnostics()["td_error"] == pytest.approx(1000.0)
 
 
 def test_discrete_observations_are_one_hot_and_learn_a_table():

@@ -1,0 +1,39 @@
+import gymnasium
+import numpy as np
+
+from confront.learning import make_learner
+from confront.learning.envloop import run_episodes
+from confront.learning.migration import BinaryTreeMigration
+
+
+def test_td_learner_solves_frozen_lake():
+    env = gymnasium.make("FrozenLake-v1", is_slippery=False)
+    rng = np.random.default_rng(0)
+    lr = make_learner("qlearning_egreedy", n_states=16, n_actions=4, alpha=0.5, gamma=0.95, exploit=0.7)
+    run_episodes(env, lr, rng, 600)
+    assert run_episodes(env, lr, rng, 5, learn=False, explore=False, max_steps=50).tolist() == [1.0] * 5
+
+
+def test_dmnn_on_one_hot_states_solves_a_small_tree():
+    env = BinaryTreeMigration(layers=3, reward=1.0)
+    rng = np.random.default_rng(1)
+    lr = make_learner("dmnn", observation="discrete", n_inputs=8, n_actions=2, hidden=(8,), alpha=1.0,
+                      awm=False, nn_rate=0.5, q_scale=1.0, t_max=0.5, t_min=0.05, eta=0.99)
+    run_episodes(env, lr, rng, 300)
+    assert np.allclose(run_episodes(env, lr, rng, 3, learn=False, explore=False), 1.0)
+    q = lr.q_values(np.array([1, 3]))
+    assert q[0, 1] > q[0, 0] and q[1, 1] > q[1, 0]
+
+
+def test_actions_held_for_the_sojourn():
+    env = BinaryTreeMigration(layers=5)  # 4 decisions, held 2 at a time: 2 SMDP steps per episode
+    lr = make_learner("ssaq", n_states=32, n_actions=2, backup="smdp")
+    rng = np.random.default_rng(2)
+    run_episodes(env, lr, rng, 200, sojourn=2)
+    assert lr.step == 400
+    # right-right from 7 reaches the goal 31 on the second held turn: Q(7, right) = 0 + 0.9 * 1000 (smdp);
+    # right-right from the root reaches 7: Q(1, right) = 0.9^2 * 900
+    assert np.isclose(lr.q[7, 1], 900.0, rtol=1e-3)
+    assert np.isclose(lr.q[1, 1], 729.0, rtol=1e-2)
+    # only the root and layer 3 (nodes 4..7) are decision points when actions are held for 2 layers
+    assert not lr.q[[2, 3, 8, 15]].any()

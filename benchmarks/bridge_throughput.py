@@ -12,7 +12,7 @@ import time
 
 from confront.engine.battle import BattleSpec, Team
 from confront.engine.bridge import nearest_enemy_policy
-from confront.engine.bridged import BRIDGE_BOT, BridgedRun, run_bridged_battle
+from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 
 OPPONENTS = ("Walls", "Tracker", "SpinBot", "RamFire")
@@ -41,7 +41,8 @@ def _record(name: str, mode: str, run: EngineRun, wall: float, bridged: BridgedR
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=10)
-    ap.add_argument("--cpu-ms", type=float, default=10.0, help="engine CPU constant (robot time per turn)")
+    ap.add_argument("--cpu-ms", type=float, default=BRIDGE_CPU_CONSTANT_MS,
+                    help="engine CPU constant (ms per robot turn)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--every", type=int, default=1, help="ask Python every k turns (SMDP step)")
     ap.add_argument("--json", action="store_true", help="print the records as one JSON list at the end")

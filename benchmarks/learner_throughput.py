@@ -57,7 +57,9 @@ def main() -> None:
         ("qlearning_egreedy", "TD team (tabular, e-greedy)", {}),
         ("dmnn", "DMNN 8-32-4, AWM", {"hidden": (32,)}),
         ("dmnn", "DMNN 8-32-4, AWM, fuzzy rate", {"hidden": (32,), "rate": "fuzzy"}),
+        ("dmnn", "DMNN 8-32-4, AWM, float32", {"hidden": (32,), "dtype": "float32"}),
         ("dmnn", "DMNN 8-64-64-4, AWM", {"hidden": (64, 64)}),
+        ("dmnn", "DMNN 8-64-64-4, AWM, float32", {"hidden": (64, 64), "dtype": "float32"}),
         ("dmnn", "DMNN 320(one-hot)-32-4", {"hidden": (32,), "observation": "discrete", "n_inputs": 320}),
     ]
     print(f"threads: OPENBLAS_NUM_THREADS={os.environ['OPENBLAS_NUM_THREADS']}, load average "

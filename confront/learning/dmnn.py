@@ -46,6 +46,7 @@ __all__ = [
 
 OUTPUTS = ("linear", "bipolar")
 OBSERVATIONS = ("features", "discrete")
+DTYPES = ("float64", "float32")
 
 
 def bipolar(x: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -144,8 +145,10 @@ class DMNNParams(LearnerParams):
     exploit: float = 0.95
     exploit_decay: float = 0.99
     init_seed: int = 0
+    dtype: str = "float64"
 
     def validate(self) -> None:
+        check_choice("dtype", self.dtype, DTYPES)
         check_int("n_inputs", self.n_inputs, 1)
         check_int("n_actions", self.n_actions, 1)
         check_choice("observation", self.observation, OBSERVATIONS)
@@ -189,9 +192,10 @@ class DMNN(Learner):
         self._fuzzy = FuzzyLearningRate(fuzzy) if p.rate == "fuzzy" else None
         self._linear = p.output == "linear"
         rng = rng if rng is not None else np.random.default_rng(p.init_seed)
+        self.dtype = np.dtype(p.dtype)
         sizes = (p.n_inputs, *p.hidden, p.n_actions)
-        self.weights = [rng.uniform(-1.0, 1.0, (i, o)) / np.sqrt(i) for i, o in pairwise(sizes)]
-        self.biases = [np.zeros(o) for o in sizes[1:]]
+        self.weights = [(rng.uniform(-1.0, 1.0, (i, o)) / np.sqrt(i)).astype(self.dtype) for i, o in pairwise(sizes)]
+        self.biases = [np.zeros(o, dtype=self.dtype) for o in sizes[1:]]
         self.vel_w = [np.zeros_like(w) for w in self.weights]
         self.vel_b = [np.zeros_like(th) for th in self.biases]
         self.step = 0
@@ -204,10 +208,10 @@ class DMNN(Learner):
             s = np.asarray(obs).reshape(-1)
             if not np.issubdtype(s.dtype, np.integer) or (s.size and (s.min() < 0 or s.max() >= n_in)):
                 raise ValueError(f"obs must be integer states in [0, {n_in}) for a discrete DMNN")
-            x = np.zeros((s.size, n_in))
+            x = np.zeros((s.size, n_in), dtype=self.dtype)
             x[np.arange(s.size), s] = 1.0
             return x
-        x = np.asarray(obs, dtype=np.float64)
+        x = np.asarray(obs, dtype=self.dtype)
         if x.ndim != 2 or x.shape[1] != n_in:
             raise ValueError(f"obs must have shape (N, {n_in}) for a features DMNN, got {x.shape}")
         return x
@@ -215,7 +219,8 @@ class DMNN(Learner):
     def q_values(self, obs: np.ndarray) -> np.ndarray:
         """Q(s, .) in reward units, (N, A)."""
         p = self.params
-        return p.q_scale * forward(self.weights, self.biases, self.inputs(obs), p.a, p.b, self._linear)[-1]
+        y = forward(self.weights, self.biases, self.inputs(obs), p.a, p.b, self._linear)[-1]
+        return p.q_scale * y.astype(np.float64)
 
     def act(self, obs: np.ndarray, rng: np.random.Generator, explore: bool = True) -> np.ndarray:
         # Eq. 30-31: softmax layer over the Q outputs at the annealed temperature
@@ -303,9 +308,9 @@ class DMNN(Learner):
             expected.update({f"w{i}": w.shape, f"b{i}": th.shape, f"vw{i}": w.shape, f"vb{i}": th.shape})
         require_keys(state, expected)
         k = len(self.weights)
-        self.weights = [np.array(state[f"w{i}"], dtype=np.float64) for i in range(k)]
-        self.biases = [np.array(state[f"b{i}"], dtype=np.float64) for i in range(k)]
-        self.vel_w = [np.array(state[f"vw{i}"], dtype=np.float64) for i in range(k)]
-        self.vel_b = [np.array(state[f"vb{i}"], dtype=np.float64) for i in range(k)]
+        self.weights = [np.array(state[f"w{i}"], dtype=self.dtype) for i in range(k)]
+        self.biases = [np.array(state[f"b{i}"], dtype=self.dtype) for i in range(k)]
+        self.vel_w = [np.array(state[f"vw{i}"], dtype=self.dtype) for i in range(k)]
+        self.vel_b = [np.array(state[f"vb{i}"], dtype=self.dtype) for i in range(k)]
         self.step = int(state["step"])
         self._last = np.array(state["last"], dtype=np.float64)

@@ -190,3 +190,20 @@ def test_bad_dmnn_inputs_raise_clear_errors():
         make_learner("dmnn", output="relu")
     with pytest.raises(ValueError, match=r"\(N, 8\)"):
         make_learner("dmnn").act(np.zeros((2, 3)), np.random.default_rng(0))
+
+
+def test_float32_network_tracks_float64():
+    rng = np.random.default_rng(4)
+    n64 = make_learner("dmnn", hidden=(16,), rate="fuzzy")
+    n32 = make_learner("dmnn", hidden=(16,), rate="fuzzy", dtype="float32")
+    assert n32.weights[0].dtype == np.float32
+    for _ in range(5):
+        x = rng.normal(size=(32, 8))
+        batch = Transition(x, rng.integers(0, 4, 32), rng.normal(0, 5, (32, 4)), rng.normal(size=(32, 8)),
+                           np.zeros(32, dtype=bool))
+        n64.learn(batch)
+        n32.learn(batch)
+    for w64, w32 in zip(n64.weights, n32.weights, strict=True):
+        assert np.allclose(w64, w32, atol=1e-4)
+    with pytest.raises(ValueError, match="dtype"):
+        make_learner("dmnn", dtype="float16")

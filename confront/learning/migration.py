@@ -23,16 +23,22 @@ from confront.learning.factory import make_learner
 
 __all__ = [
     "METHODS",
+    "PAPER_SSAQ",
     "TRACKED",
     "BinaryTreeMigration",
     "MigrationResult",
     "convergence_episode",
+    "convergence_table",
+    "format_summary",
+    "paper_claims",
     "q_limit",
     "plot_migration",
     "run_migration",
 ]
 
 TRACKED = (3, 7, 15)
+PAPER_SSAQ = {3: 214, 7: 168, 15: 122}  # §6.2: SSAQ's convergence episodes for Q_3, Q_7, Q_15
+LABELS = {"ssaq": "SSAQ", "greedy": "Greedy-policy", "dgreedy": "Dgreedy-policy"}
 # method -> (learner kind, its exploration); all use Table 1's alpha, gamma, epsilon, eta, T_max, T_min
 METHODS = {"ssaq": "ssaq", "greedy": "qlearning_egreedy", "dgreedy": "qlearning_dgreedy"}
 
@@ -191,30 +197,82 @@ def run_migration(
     return MigrationResult(q=q, limits=limits, convergence=conv, first_goal=first, settings=settings)
 
 
-def plot_migration(result: MigrationResult, path: str | Path, max_episode: int | None = None) -> Path:
-    """Figure 9: Q_3, Q_7, Q_15 per episode, median line and interquartile band over seeds per method (PNG)."""
+def plot_migration(result: MigrationResult, path: str | Path, max_episode: int | None = None) -> list[Path]:
+    """Figure 9: Q_3, Q_7, Q_15 per episode, median line and interquartile band over seeds per method.
+
+    ``path`` is a ``.png`` file or a folder (then ``figure9_migration.png`` inside it); returns the files written.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(13, 3.8))
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(TRACKED))
-    labels = {"ssaq": "SSAQ", "greedy": "Greedy-policy", "dgreedy": "Dgreedy-policy"}
     for j, (ax, node) in enumerate(zip(axes, TRACKED, strict=True)):
         for m, runs in result.q.items():
             vals = runs[:, :max_episode, j]
             x = np.arange(1, vals.shape[1] + 1)
             q25, med, q75 = np.quantile(vals, [0.25, 0.5, 0.75], axis=0)
-            (line,) = ax.plot(x, med, label=labels.get(m, m), lw=1.2)
+            (line,) = ax.plot(x, med, label=LABELS.get(m, m), lw=1.2)
             ax.fill_between(x, q25, q75, color=line.get_color(), alpha=0.2, lw=0)
         ax.axhline(result.limits[j], color="k", ls="--", lw=0.8, label="limit")
         ax.set(title=f"({'abc'[j]}) Q_{node}", xlabel="episode", ylabel=f"Q_{node}")
         ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     out = Path(path)
+    if out.suffix.lower() != ".png":
+        out = out / "figure9_migration.png"
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=120)
-    return out
+    return [out]
+
+
+def _cell(r: dict[str, float], prefix: str = "") -> str:
+    return f"{r[prefix + 'median']:.0f} [{r[prefix + 'q25']:.0f}, {r[prefix + 'q75']:.0f}]"
+
+
+def convergence_table(result: MigrationResult) -> str:
+    """Markdown table: median [IQR] convergence episode per method and Q, the paper's SSAQ row first."""
+    head = "| method | " + " | ".join(f"Q_{k}" for k in TRACKED) + " | converged runs | Q_3 after first goal |"
+    lines = [head, "|" + "---|" * (len(TRACKED) + 3),
+             "| paper, SSAQ | " + " | ".join(str(PAPER_SSAQ[k]) for k in TRACKED) + " | - | - |"]
+    for m, rows in result.summary().items():
+        cells = [_cell(rows[f"Q{k}"]) for k in TRACKED]
+        conv = min(int(rows[f"Q{k}"]["converged"]) for k in TRACKED)
+        seeds = int(rows[f"Q{TRACKED[0]}"]["seeds"])
+        lines.append(f"| {LABELS.get(m, m)} | " + " | ".join(cells)
+                     + f" | {conv}/{seeds} | {_cell(rows[f'Q{TRACKED[0]}'], 'after_goal_')} |")
+    return "\n".join(lines)
+
+
+def paper_claims(result: MigrationResult) -> list[dict[str, Any]]:
+    """The paper's Figure 9 claims checked on ``result``: text, ours (str), holds (bool or None), detail."""
+    s = result.summary()
+    claims: list[dict[str, Any]] = []
+    if "ssaq" in s:
+        med = {k: s["ssaq"][f"Q{k}"]["median"] for k in TRACKED}
+        ours = ", ".join(f"Q_{k} {med[k]:.0f}" for k in TRACKED)
+        claims.append({
+            "text": "SSAQ converges in 214, 168 and 122 episodes for Q_3, Q_7, Q_15",
+            "ours": f"median {ours}",
+            "holds": bool(all(abs(med[k] - PAPER_SSAQ[k]) <= 0.25 * PAPER_SSAQ[k] for k in TRACKED)),
+            "detail": "holds if every median is within 25% of the paper's episode count",
+        })
+        claims.append({
+            "text": "Q_15 converges first, then Q_7, then Q_3",
+            "ours": ours,
+            "holds": bool(med[15] <= med[7] <= med[3]),
+        })
+        others = [m for m in s if m != "ssaq"]
+        if others:
+            worse = [f"{LABELS.get(m, m)} Q_{k} {s[m][f'Q{k}']['median']:.0f}" for m in others for k in TRACKED]
+            claims.append({
+                "text": "SSAQ converges faster than the Greedy and Dgreedy policies",
+                "ours": f"SSAQ {ours}; " + ", ".join(worse),
+                "holds": bool(all(med[k] < s[m][f"Q{k}"]["median"] for m in others for k in TRACKED)),
+                "detail": "compared by the median convergence episode over seeds",
+            })
+    return claims
 
 
 def format_summary(result: MigrationResult) -> str:
@@ -242,7 +300,8 @@ def main(argv: list[str] | None = None) -> None:
     res = run_migration(seeds=args.seeds, episodes=args.episodes, layers=args.layers, workers=args.workers)
     print(format_summary(res))
     print(f"limits Q3, Q7, Q15: {', '.join(f'{x:.2f}' for x in res.limits)}")
-    print(f"plot: {plot_migration(res, args.plot)}")
+    print(convergence_table(res))
+    print(f"plot: {plot_migration(res, args.plot)[0]}")
 
 
 if __name__ == "__main__":

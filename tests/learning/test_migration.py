@@ -4,6 +4,8 @@ import pytest
 from confront.learning.migration import (
     BinaryTreeMigration,
     convergence_episode,
+    convergence_table,
+    paper_claims,
     plot_migration,
     q_limit,
     run_migration,
@@ -50,8 +52,15 @@ def test_ssaq_reaches_the_optimum_on_a_small_tree(tmp_path):
     s = res.summary()
     assert s["ssaq"]["Q3"]["converged"] == 3.0
     assert s["ssaq"]["Q3"]["q25"] <= s["ssaq"]["Q3"]["median"] <= s["ssaq"]["Q3"]["q75"]
-    out = plot_migration(res, tmp_path / "fig9.png")
+    (out,) = plot_migration(res, tmp_path / "fig9.png")
     assert out.stat().st_size > 1000
+    assert plot_migration(res, tmp_path)[0].name == "figure9_migration.png"
+    table = convergence_table(res)
+    assert "| paper, SSAQ | 214 | 168 | 122 |" in table and "| SSAQ |" in table
+    claims = paper_claims(res)
+    assert [c["text"][:14] for c in claims] == ["SSAQ converges", "Q_15 converges", "SSAQ converges"]
+    order = s["ssaq"]
+    assert claims[1]["holds"] == (order["Q15"]["median"] <= order["Q7"]["median"] <= order["Q3"]["median"])
 
 
 def test_greedy_policy_of_trained_ssaq_takes_the_rewarding_path():

@@ -25,9 +25,17 @@ from confront.learning.base import (
 from confront.learning.exploration import ExplorationParams, policy_probs, select_actions
 from confront.learning.fuzzy import FuzzyLearningRate, FuzzyParams
 
-__all__ = ["RATES", "TabularParams", "TabularQ"]
+__all__ = ["RATES", "TabularParams", "TabularQ", "table_update"]
 
 RATES = ("fixed", "fuzzy")
+
+
+def table_update(q: np.ndarray, s: np.ndarray, a: np.ndarray, step: np.ndarray) -> np.ndarray:
+    """New table after adding ``step`` = alpha (target - Q) at (s, a); steps hitting one cell are averaged."""
+    idx = s * q.shape[1] + a
+    sums = np.bincount(idx, weights=step, minlength=q.size)
+    counts = np.bincount(idx, minlength=q.size)
+    return q + (sums / np.maximum(counts, 1)).reshape(q.shape)  # Eq. 4 / Eq. 10: Q <- Q + alpha (target - Q)
 
 
 @dataclass(frozen=True)
@@ -115,12 +123,7 @@ class TabularQ(Learner):
         target = self.targets(batch)
         td = target - self.q[s, a]
         alpha = self.learning_rate(batch.rewards)
-        idx = s * self.n_actions + a
-        size = self.q.size
-        sums = np.bincount(idx, weights=alpha * td, minlength=size)
-        counts = np.bincount(idx, minlength=size)
-        # Eq. 10 / Eq. 4 as TD updates Q <- Q + alpha (target - Q), duplicates of one (s, a) averaged
-        self.q += (sums / np.maximum(counts, 1)).reshape(self.q.shape)
+        self.q = table_update(self.q, s, a, alpha * td)
         self.step += 1
         self._last = np.array([np.abs(td).mean() if td.size else 0.0, alpha.mean() if alpha.size else 0.0])
         return {"td_error": float(self._last[0]), "learning_rate": float(self._last[1])}

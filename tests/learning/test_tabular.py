@@ -38,6 +38,15 @@ def test_duplicate_state_actions_are_averaged():
     assert lr.q[0, 1] == pytest.approx(0.5 * 4.0)
 
 
+def test_table_update_is_pure_and_averages():
+    from confront.learning.tabular import table_update
+
+    q = np.zeros((2, 2))
+    out = table_update(q, np.array([1, 1, 0]), np.array([0, 0, 1]), np.array([1.0, 3.0, -2.0]))
+    assert np.array_equal(out, [[0.0, -2.0], [2.0, 0.0]])
+    assert not q.any()
+
+
 def test_fuzzy_rate_is_used_per_transition():
     lr = make_learner("ssaq", n_states=2, n_actions=2, rate="fuzzy")
     lr.learn(_batch([0, 1], [0, 0], [[10.0, 10.0], [0.0, 0.0]], [1, 0], [True, True]))

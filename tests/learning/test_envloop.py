@@ -37,3 +37,16 @@ def test_actions_held_for_the_sojourn():
     assert np.isclose(lr.q[1, 1], 729.0, rtol=1e-2)
     # only the root and layer 3 (nodes 4..7) are decision points when actions are held for 2 layers
     assert not lr.q[[2, 3, 8, 15]].any()
+
+
+def test_dmnn_with_awm_and_default_scaling_learns_the_tree():
+    env = BinaryTreeMigration(layers=4, reward=10.0)
+    rng = np.random.default_rng(0)
+    lr = make_learner("dmnn", observation="discrete", n_inputs=16, n_actions=2, hidden=(16,), alpha=0.5,
+                      t_max=1.0, t_min=0.1, eta=0.995)
+    run_episodes(env, lr, rng, 800)
+    assert np.allclose(run_episodes(env, lr, rng, 3, learn=False, explore=False), 10.0)
+    q = lr.q_values(np.array([1, 3, 7]))
+    # limits 8.1, 9, 10 (paper backup, gamma 0.9); AWM's rate shrinks with the error, so it nears them slowly
+    assert np.allclose(q[:, 1], [8.1, 9.0, 10.0], atol=1.0)
+    assert np.all(q[:, 0] < q[:, 1] - 5)

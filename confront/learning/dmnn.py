@@ -263,15 +263,15 @@ class DMNN(Learner):
         _, _, gw, gb = td_loss_and_grads(self.weights, self.biases, x, a, labels, p.a, p.b, self._linear,
                                          pattern_rates=lam, acts=acts)
         beta = p.momentum if p.awm else 0.0
+        vel_w = [beta * v - g for v, g in zip(self.vel_w, gw, strict=True)]  # Eq. 23: dw = beta dw - lambda dE/dw
+        vel_b = [beta * v - g for v, g in zip(self.vel_b, gb, strict=True)]
+        if not all(np.isfinite(v).all() for v in vel_w + vel_b):
+            raise FloatingPointError("DMNN update is non-finite (weights left unchanged): lower td_clip or "
+                                     "raise q_scale")
+        self.vel_w, self.vel_b = vel_w, vel_b
         for i in range(len(self.weights)):
-            self.vel_w[i] *= beta  # Eq. 23: dw(t) = beta dw(t-1) - lambda dE/dw
-            self.vel_w[i] -= gw[i]
-            self.vel_b[i] *= beta
-            self.vel_b[i] -= gb[i]
-            self.weights[i] += self.vel_w[i]
-            self.biases[i] += self.vel_b[i]
-        if not all(np.isfinite(w).all() for w in self.weights):
-            raise FloatingPointError("DMNN weights became non-finite: lower td_clip or raise q_scale")
+            self.weights[i] += vel_w[i]
+            self.biases[i] += vel_b[i]
         self.step += 1
         self._last = np.array([np.abs(td).mean() * p.q_scale, alpha.mean(), lam.mean(), e_p.mean()])
         return {"td_error": float(self._last[0]), "learning_rate": float(self._last[1]),

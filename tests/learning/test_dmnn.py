@@ -207,3 +207,12 @@ def test_float32_network_tracks_float64():
         assert np.allclose(w64, w32, atol=1e-4)
     with pytest.raises(ValueError, match="dtype"):
         make_learner("dmnn", dtype="float16")
+
+
+def test_non_finite_update_raises_and_keeps_weights():
+    net = make_learner("dmnn", hidden=(4,), td_clip=0.0, q_scale=1e-300)
+    before = [w.copy() for w in net.weights]
+    x = np.ones((2, 8))
+    with pytest.raises(FloatingPointError, match="unchanged"):
+        net.learn(Transition(x, np.array([0, 1]), np.full((2, 1), 1e300), x, np.ones(2, dtype=bool)))
+    assert all(np.array_equal(a, b) for a, b in zip(before, net.weights, strict=True))

@@ -2,7 +2,7 @@
 
 from confront.learning.base import Learner, Transition
 from confront.learning.dmnn import DMNN, DMNNParams
-from confront.learning.envloop import run_episodes
+from confront.learning.envloop import run_episodes, run_parallel_episodes
 from confront.learning.factory import clone_learner, load_learner, make_learner, save_learner, transfer_from
 from confront.learning.fuzzy import FuzzyLearningRate, FuzzyParams, paper_learning_rate, plot_fuzzy
 from confront.learning.sharing import team_act, team_learn
@@ -28,6 +28,7 @@ __all__ = [
     "paper_learning_rate",
     "plot_fuzzy",
     "run_episodes",
+    "run_parallel_episodes",
     "save_learner",
     "team_act",
     "team_learn",

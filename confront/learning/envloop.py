@@ -1,4 +1,6 @@
-"""Running a learner on any Gymnasium environment with a discrete action space (one agent, SMDP steps)."""
+"""Running a learner on any Gymnasium environment (one agent) or PettingZoo parallel environment (every agent
+through one shared learner, §4.2) with discrete actions, each action held for an SMDP step of ``sojourn``
+environment steps."""
 
 from __future__ import annotations
 
@@ -8,7 +10,7 @@ import numpy as np
 
 from confront.learning.base import Learner, Transition, check_int
 
-__all__ = ["run_episodes"]
+__all__ = ["run_episodes", "run_parallel_episodes"]
 
 
 def _row(obs: Any, learner: Learner) -> np.ndarray:
@@ -55,4 +57,50 @@ def run_episodes(
             if learn:
                 learner.learn(Transition(x, np.array([action]), rewards, _row(obs, learner),
                                          np.array([terminated])))
+    return returns
+
+
+def run_parallel_episodes(
+    env: Any,
+    learner: Learner,
+    rng: np.random.Generator,
+    episodes: int,
+    sojourn: int = 1,
+    learn: bool = True,
+    explore: bool = True,
+    max_steps: int = 10_000,
+) -> np.ndarray:
+    """Like :func:`run_episodes` for a PettingZoo ``ParallelEnv``: all live agents act through ``learner`` and
+    their SMDP transitions form one batch per step (parameter sharing). Returns the team's summed return per
+    episode. An agent that ends inside a held step keeps its last observation and is marked done."""
+    check_int("episodes", episodes, 0)
+    check_int("sojourn", sojourn, 1)
+    returns = np.zeros(episodes)
+    for e in range(episodes):
+        obs, _ = env.reset(seed=int(rng.integers(2**31)))
+        steps = 0
+        while env.agents and steps < max_steps:
+            agents = list(env.agents)
+            x = np.concatenate([_row(obs[ag], learner) for ag in agents])
+            actions = learner.act(x, rng, explore)
+            rewards = np.zeros((len(agents), sojourn))
+            ended = np.zeros(len(agents), dtype=bool)
+            last = dict(obs)
+            for i in range(sojourn):
+                live = {ag: int(a) for ag, a, gone in zip(agents, actions, ended, strict=True) if not gone}
+                obs, rew, term, trunc, _ = env.step(live)
+                steps += 1
+                for k, ag in enumerate(agents):
+                    if ag in live:
+                        rewards[k, i] = rew.get(ag, 0.0)
+                        last[ag] = obs.get(ag, last[ag])
+                        ended[k] |= bool(term.get(ag, False))
+                        if trunc.get(ag, False):
+                            live.pop(ag)
+                if not env.agents or steps >= max_steps:
+                    break
+            returns[e] += rewards.sum()
+            if learn:
+                nxt = np.concatenate([_row(last[ag], learner) for ag in agents])
+                learner.learn(Transition(x, actions, rewards, nxt, ended))
     return returns

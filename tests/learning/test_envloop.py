@@ -50,3 +50,37 @@ def test_dmnn_with_awm_and_default_scaling_learns_the_tree():
     # limits 8.1, 9, 10 (paper backup, gamma 0.9); AWM's rate shrinks with the error, so it nears them slowly
     assert np.allclose(q[:, 1], [8.1, 9.0, 10.0], atol=1.0)
     assert np.all(q[:, 0] < q[:, 1] - 5)
+
+
+class _TwoTreeWalkers:
+    """A minimal PettingZoo-style parallel env: two agents each walk their own 3-layer tree."""
+
+    possible_agents = ["a", "b"]
+
+    def reset(self, seed=None, options=None):
+        self.agents = list(self.possible_agents)
+        self.node = {"a": 1, "b": 1}
+        return dict(self.node), {ag: {} for ag in self.agents}
+
+    def step(self, actions):
+        obs, rew, term, trunc = {}, {}, {}, {}
+        for ag, act in actions.items():
+            self.node[ag] = 2 * self.node[ag] + act
+            obs[ag] = self.node[ag]
+            rew[ag] = 1.0 if self.node[ag] == 7 else 0.0
+            term[ag] = self.node[ag] >= 4
+            trunc[ag] = False
+        self.agents = [ag for ag in self.agents if not term.get(ag, False)]
+        return obs, rew, term, trunc, {ag: {} for ag in actions}
+
+
+def test_parallel_agents_share_one_learner():
+    from confront.learning.envloop import run_parallel_episodes
+
+    env = _TwoTreeWalkers()
+    lr = make_learner("qlearning_egreedy", n_states=8, n_actions=2, alpha=0.5, exploit=0.5)
+    rng = np.random.default_rng(3)
+    run_parallel_episodes(env, lr, rng, 200)
+    assert lr.step == 400  # 2 SMDP steps per episode, each one batch of both agents
+    assert run_parallel_episodes(env, lr, rng, 2, learn=False, explore=False).tolist() == [2.0, 2.0]
+    assert np.isclose(lr.q[3, 1], 1.0) and np.isclose(lr.q[1, 1], 0.9)

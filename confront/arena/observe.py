@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numba import njit, vectorize
 
 N_REL_BINS = 4
 N_HEADING_BINS = 4
@@ -60,17 +61,45 @@ class ObservationConfig:
         return 9 if self.include_position else 7
 
 
-def normal_absolute_angle(a: np.ndarray) -> np.ndarray:
-    """Angle in [0, 2*pi)."""
+@vectorize(["float64(float64)"], cache=True)
+def normal_absolute_angle(a: float) -> float:
+    """Angle in [0, 2*pi) (a NumPy ufunc; also callable on scalars in compiled code)."""
     # Robocode Utils.normalAbsoluteAngle
-    r = np.mod(a, TWO_PI)
-    return np.where(r >= TWO_PI, 0.0, r)
+    r = a % TWO_PI
+    return 0.0 if r >= TWO_PI else r
 
 
 def absolute_bearing(x: np.ndarray, y: np.ndarray, tx: np.ndarray, ty: np.ndarray) -> np.ndarray:
     """Absolute bearing from (x, y) to (tx, ty), in [0, 2*pi), 0 = north, clockwise."""
     # Robocode heading convention: x += sin(h), y += cos(h), so bearing = atan2(dx, dy)
     return normal_absolute_angle(np.arctan2(tx - x, ty - y))
+
+
+TARGET_RULES: dict[str, int] = {"nearest": 0, "weakest": 1}
+
+
+@njit(cache=True)
+def target_of(x: np.ndarray, y: np.ndarray, energy: np.ndarray, alive: np.ndarray, team: np.ndarray,
+              i: int, rule: int) -> int:
+    """Target of robot i among the (R,) rows: nearest living enemy (rule 0), or least energy then nearest
+    (rule 1); ties go to the lower index; -1 if no enemy is alive."""
+    best, best_e, best_d = -1, np.inf, np.inf
+    for j in range(x.shape[0]):
+        if team[j] == team[i] or not alive[j]:
+            continue
+        dx, dy = x[j] - x[i], y[j] - y[i]
+        d = dx * dx + dy * dy
+        e = energy[j] if rule == 1 else 0.0
+        if e < best_e or (e == best_e and d < best_d):
+            best, best_e, best_d = j, e, d
+    return best
+
+
+@njit(cache=True)
+def _targets_kernel(x, y, energy, alive, team, rule, out):  # noqa: ANN001 - numba kernel
+    for b in range(x.shape[0]):
+        for i in range(x.shape[1]):
+            out[b, i] = target_of(x[b], y[b], energy[b], alive[b], team[b], i, rule)
 
 
 def select_targets(
@@ -85,22 +114,14 @@ def select_targets(
 
     ``x, y, energy, alive`` are (B, R); ``team`` is (R,) or (B, R) team ids.
     """
-    dx = x[:, None, :] - x[:, :, None]  # (B, R_self, R_other)
-    dy = y[:, None, :] - y[:, :, None]
-    dist2 = dx * dx + dy * dy
-    team_b = np.broadcast_to(team, x.shape)
-    enemy = (team_b[:, :, None] != team_b[:, None, :]) & alive[:, None, :]
-    if rule == "nearest":
-        key = np.where(enemy, dist2, np.inf)
-    elif rule == "weakest":
-        # least energy first; the distance term (< 1e-9) only breaks ties
-        tie = dist2 / (1.0 + dist2.max(initial=0.0)) * 1e-9
-        key = np.where(enemy, energy[:, None, :] + tie, np.inf)
-    else:
+    if rule not in TARGET_RULES:
         raise ValueError(f"target rule must be 'nearest' or 'weakest', got {rule!r}")
-    tgt = np.argmin(key, axis=2)
-    has = np.isfinite(np.take_along_axis(key, tgt[:, :, None], axis=2)[:, :, 0])
-    return np.where(has, tgt, -1).astype(np.int64)
+    out = np.empty(x.shape, dtype=np.int64)
+    team_b = np.ascontiguousarray(np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape))
+    _targets_kernel(np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64),
+                    np.ascontiguousarray(energy, dtype=np.float64), np.ascontiguousarray(alive, dtype=np.bool_),
+                    team_b, TARGET_RULES[rule], out)
+    return out
 
 
 def gather_target(values: np.ndarray, target: np.ndarray, fill: float = 0.0) -> np.ndarray:
@@ -125,22 +146,36 @@ def relative_geometry(
     return rel, dist
 
 
-def angle_bins(angle: np.ndarray, n: int, centred: bool) -> np.ndarray:
-    """Bin an angle in [0, 2*pi) into n equal sectors; ``centred`` puts sector 0 around angle 0."""
+@vectorize(["int64(float64, int64, boolean)"], cache=True)
+def angle_bin(angle: float, n: int, centred: bool) -> int:
+    """Sector of an angle among n equal sectors (ufunc); ``centred`` puts sector 0 around angle 0."""
     width = TWO_PI / n
     a = normal_absolute_angle(angle + (width / 2 if centred else 0.0))
-    return np.minimum((a / width).astype(np.int64), n - 1)
+    return min(int(a / width), n - 1)
+
+
+@vectorize(["int64(float64, float64, int64)"], cache=True)
+def distance_bin(dist: float, max_distance: float, n: int) -> int:
+    """Equal-width bin of a distance over [0, max_distance) (ufunc); farther goes to the last bin."""
+    return min(max(int(np.floor(dist * (n / max_distance))), 0), n - 1)
+
+
+def angle_bins(angle: np.ndarray, n: int, centred: bool) -> np.ndarray:
+    """Bin angles into n equal sectors; ``centred`` puts sector 0 around angle 0."""
+    return angle_bin(angle, n, centred)
 
 
 def distance_bins(dist: np.ndarray, max_distance: float, n: int = N_DIST_BINS) -> np.ndarray:
     """Equal-width distance bins over [0, max_distance); farther distances go to the last bin."""
-    b = np.floor(dist * (n / max_distance)).astype(np.int64)
-    return np.clip(b, 0, n - 1)
+    return distance_bin(dist, float(max_distance), n)
 
 
 def state_index(rel_bin: np.ndarray, heading_bin: np.ndarray, dist_bin: np.ndarray) -> np.ndarray:
     """Paper's discrete state 0..319 = (rel_bin * 4 + heading_bin) * 20 + dist_bin."""
     return (rel_bin * N_HEADING_BINS + heading_bin) * N_DIST_BINS + dist_bin
+
+
+state_index_scalar = njit(cache=True)(state_index)  # the same rule compiled for kernels
 
 
 def field_diagonal(width: float, height: float) -> float:
@@ -196,10 +231,55 @@ def reward_eq35(
     enemy_now: np.ndarray,
     guard: float = 1.0,
 ) -> np.ndarray:
-    """Per-turn reward of the paper's Eq. 35, denominator floored at ``guard``."""
+    """Per-turn reward of the paper's Eq. 35, denominator floored at ``guard`` (arrays or scalars)."""
     # Eq. 35: ((Em_t - Em_t-1) - (Ee_t - Ee_t-1)) * |Ee_t-1 - Ee_t| / max(|Em_t-1 - Ee_t-1|, guard)
     delta = (own_now - own_prev) - (enemy_now - enemy_prev)
     return delta * np.abs(enemy_prev - enemy_now) / np.maximum(np.abs(own_prev - enemy_prev), guard)
+
+
+reward_eq35_scalar = njit(cache=True)(reward_eq35)  # the same rule compiled for the SMDP kernel
+
+
+@njit(cache=True)
+def robot_observation(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray, i: int, tgt: int,
+                      max_distance: float, width: float, height: float, feat: np.ndarray) -> int:
+    """Discrete state of robot i toward robot tgt (-1: none) from (R,) rows; writes its features in ``feat``
+    (x/W, y/H too when ``feat`` has 9 entries). The same rules as discrete_state() and features()."""
+    if tgt >= 0:
+        dx, dy = x[tgt] - x[i], y[tgt] - y[i]
+        dist = np.hypot(dx, dy)
+        rel = normal_absolute_angle(normal_absolute_angle(np.arctan2(dx, dy)) - h[i])
+        te = e[tgt]
+    else:
+        dist, rel, te = 0.0, 0.0, 0.0
+    feat[0] = np.sin(rel)
+    feat[1] = np.cos(rel)
+    feat[2] = np.sin(h[i])
+    feat[3] = np.cos(h[i])
+    feat[4] = min(dist / max_distance, 1.0)
+    feat[5] = e[i] / 100.0
+    feat[6] = te / 100.0
+    if feat.shape[0] > 7:
+        feat[7] = x[i] / width
+        feat[8] = y[i] / height
+    return state_index_scalar(angle_bin(rel, N_REL_BINS, True),
+                              angle_bin(normal_absolute_angle(h[i]), N_HEADING_BINS, False),
+                              distance_bin(dist, max_distance, N_DIST_BINS))
+
+
+@njit(cache=True)
+def observe_kernel(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray, alive: np.ndarray,
+                   team: np.ndarray, rule: int, max_distance: float, width: float, height: float,
+                   target: np.ndarray, disc: np.ndarray, feats: np.ndarray) -> None:
+    """Targets, discrete states and features of every robot of (B, R) arrays, into the outputs."""
+    row = np.zeros(feats.shape[2])
+    for b in range(x.shape[0]):
+        for i in range(x.shape[1]):
+            tg = target_of(x[b], y[b], e[b], alive[b], team[b], i, rule)
+            target[b, i] = tg
+            disc[b, i] = robot_observation(x[b], y[b], h[b], e[b], i, tg, max_distance, width, height, row)
+            for k in range(row.shape[0]):
+                feats[b, i, k] = row[k]
 
 
 def observe(
@@ -212,9 +292,12 @@ def observe(
     field: tuple[float, float],
     config: ObservationConfig,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(target (B, R), discrete state (B, R), features (B, R, F)) for every robot."""
-    target = select_targets(x, y, energy, alive, team, config.target)
+    """(target (B, R), discrete state (B, R), features (B, R, F)) for every robot (compiled)."""
     dmax = config.max_distance or field_diagonal(*field)
-    disc = discrete_state(x, y, heading, target, dmax)
-    feats = features(x, y, heading, energy, target, dmax, field if config.include_position else None)
+    target = np.empty(x.shape, dtype=np.int64)
+    disc = np.empty(x.shape, dtype=np.int64)
+    feats = np.empty(x.shape + (config.n_features,), dtype=np.float32)
+    team_b = np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape)
+    observe_kernel(x, y, heading, energy, alive, team_b, TARGET_RULES[config.target], float(dmax),
+                   float(field[0]), float(field[1]), target, disc, feats)
     return target, disc, feats

@@ -21,15 +21,29 @@ Default T = 10 turns: the paper gives no value; a 45-degree turn takes 5 turns a
 
 from __future__ import annotations
 
+import hashlib
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
+from numba import njit
 
-from .bots import BOT_NAMES, ScriptedBots
-from .control import N_MOVES, ControlConfig, gun_radar_commands, move_commands, set_adjustments
+from . import _kernels as K
+from .bots import BOT_NAMES, ScriptedBots, bots_step
+from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
 from .core import Arena
-from .observe import ObservationConfig, field_diagonal, gather_target, observe, reward_eq35, select_targets
+from .observe import (
+    TARGET_RULES,
+    ObservationConfig,
+    field_diagonal,
+    observe,
+    observe_kernel,
+    reward_eq35_scalar,
+    target_of,
+)
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
 from .state import SCORE_PARTS
@@ -143,6 +157,28 @@ class TeamBattleEnv:
         self._powers = np.asarray(self.config.fire_powers, dtype=np.float64)
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._recording: tuple[Replay, int] | None = None
+        b, r = self.n_battles, self.n_robots
+        self._move = np.zeros((b, r, 2))
+        self._move_table = np.stack(move_commands(np.arange(N_MOVES), self.config.control), axis=-1)
+        self._power = np.zeros((b, r))
+        self._turn_buf = np.zeros((4, b, r))  # per turn: target, own energy, target energy, live
+        self._kinds = self.bots.kinds.astype(np.int64) if self.bots is not None else np.zeros(r, np.int64)
+        self._rule = TARGET_RULES[self.config.observation.target]
+        c = self.config.control
+        self._ctrl = np.array([c.radar_overshoot, c.aim_tolerance, c.power_near, c.power_mid, c.power_far,
+                               c.near_distance, c.far_distance, float(c.fire)])
+        p, a = self.arena.state.packed, self.arena
+        threads = numba.get_num_threads()
+        chunks = threads if b >= _PARALLEL_MIN_BATTLES and threads > 1 else 1
+        size = -(-b // chunks)
+        self._ranges = [(lo, min(b, lo + size)) for lo in range(0, b, size)]
+        # each thread needs its own bots scratch (the bots' ``rem``)
+        self._rems = [np.zeros(4) for _ in self._ranges]
+        self._kargs = (p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
+                       p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
+                       p["placements_total"], self._cmd, a.params, a._scratch_i, a._scratch_f,
+                       self.bots.mem if self.bots is not None else np.zeros((b, r, 1)))
+        self._kargs_end = (self.field[0], self.field[1], self._turn_buf)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -228,52 +264,61 @@ class TeamBattleEnv:
             raise ValueError(f"actions must be in 0..{self.n_actions - 1}, got [{la.min()}, {la.max()}]")
         return np.where(self.learner[None, :], a, 0).astype(np.int64)
 
+    def _sync_bots(self) -> None:
+        """Scripted bots clear their memory when their battle started a new round (as ScriptedBots.commands)."""
+        bots, rnd = self.bots, self.arena.state.round
+        if bots is not None:
+            new_round = rnd != bots._round
+            if new_round.any():
+                bots.reset(new_round)
+                bots._round[:] = rnd
+
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
         a = self._check_actions(actions)
-        s, cfg, cmd, L = self.arena.state, self.config, self._cmd, self.learner
+        s, cfg, L = self.arena.state, self.config, self.learner
         T = cfg.turns_per_step
-        dist, turn = move_commands(a % N_MOVES, cfg.control)
-        power = self._powers[a // N_MOVES] if cfg.fire_power_actions else None
+        self._move[...] = self._move_table[a % N_MOVES]
+        self._power[...] = self._powers[a // N_MOVES] if cfg.fire_power_actions else 0.0
         active = s.alive & L[None, :] & ~s.done[:, None]
         rewards = np.zeros((self.n_battles, self.n_robots, T))
-        guard = cfg.observation.reward_guard
-        cmd[..., :4] = np.nan
-        cmd[..., 4] = 0.0
-        # moves are written once at the start of the SMDP step (set* semantics), then run for T turns
-        cmd[:, L, 0] = dist[:, L]
-        cmd[:, L, 1] = turn[:, L]
-        for t in range(T):
-            if t == 1:
-                cmd[:, L, :2] = np.nan
-            live = s.alive & ~s.done[:, None]
-            target = select_targets(s.x, s.y, s.energy, s.alive, self.team, cfg.observation.target)
-            gun_radar_commands(self.arena, cmd, cfg.control, target=target, robots=L)
-            if power is not None:
-                cmd[:, L, 4] = np.where(cmd[:, L, 4] > 0, power[:, L], 0.0)
-            if self.bots is not None:
-                self.bots.commands(cmd)
-            own_prev = s.energy.copy()
-            tgt_prev = gather_target(own_prev, target)
-            self.arena.step(cmd)
-            r = reward_eq35(own_prev, s.energy, tgt_prev, gather_target(s.energy, target), guard)
-            rewards[:, :, t] = np.where(live & (target >= 0), r, 0.0)
-            if self._recording is not None:
-                record_frame(self._recording[0], self.arena, self._recording[1])
-            if s.done.all():
-                break
-        return self._finish(rewards, active)
+        self._sync_bots()
+        shape = (self.n_battles, self.n_robots)
+        obs = (np.empty(shape, np.int64), np.empty(shape, np.int64),
+               np.empty(shape + (self.n_features,), np.float32))
+        if self._recording is None:
+            self._run_turns(0, T, rewards, obs)
+        else:
+            rep, b = self._recording
+            for t in range(T):
+                if self._run_turns(t, t + 1, rewards, obs) == t:
+                    break
+                record_frame(rep, self.arena, b)
+        return self._finish(rewards, active, obs)
 
-    def _finish(self, rewards: np.ndarray, active: np.ndarray) -> StepResult:
-        s = self.arena.state
-        target, disc, feats = self.observe()
-        round_done = s.done.copy()
-        truncated = round_done & ~s.decided
-        terminated = ~s.alive | round_done[:, None]
+    def _run_turns(self, t0: int, t1: int, rewards: np.ndarray, obs: tuple[np.ndarray, ...]) -> int:
+        """Turns t0..t1-1 of the SMDP step in the compiled kernel (then observations into ``obs``);
+        battle ranges run in parallel threads when there are enough battles."""
+        head = (t0, t1, self.learner, self._kinds, self.bots is not None, self._rule,
+                self.config.observation.reward_guard, self._move, self._power, self._ctrl)
+        tail = (rewards, self.max_distance, *obs)
+        if len(self._ranges) == 1:
+            return _smdp_turns(0, self.n_battles, *head, *self._kargs, self._rems[0], *self._kargs_end, *tail)
+        futures = [_pool().submit(_smdp_turns, lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
+                   for k, (lo, hi) in enumerate(self._ranges)]
+        return min(f.result() for f in futures)
+
+    def _finish(self, rewards: np.ndarray, active: np.ndarray, obs: tuple[np.ndarray, ...]) -> StepResult:
+        s = self.arena.state.arrays
+        target, disc, feats = obs
+        round_done = s["done"].copy()
+        truncated = round_done & ~s["decided"]
+        terminated = ~s["alive"] | round_done[:, None]
         res = StepResult(disc, feats, target, rewards, terminated, round_done, truncated, active)
-        res.info = {"score": s.score.copy(), "score_total": s.score_total.copy(), "round": s.round.copy(),
-                    "time": s.time.copy(), "score_parts": SCORE_PARTS}
+        res.info = {"score": s["score"].copy(), "score_total": s["score_total"].copy(),
+                    "round": s["round"].copy(), "time": s["time"].copy(), "score_parts": SCORE_PARTS}
         if round_done.any():
+            s = self.arena.state
             res.round_end = RoundEnd(round_done, s.score.copy(), s.placements.copy(), s.time.copy(),
                                      s.decided.copy(), s.alive.copy())
             if self.config.auto_reset:
@@ -307,3 +352,160 @@ class TeamBattleEnv:
     def team_ids(self) -> np.ndarray:
         """(R,) team of each robot."""
         return self.team.copy()
+
+
+# ---------------------------------------------------------------------- compiled SMDP turns
+def _purge_stale_cache() -> None:
+    """Drop this module's numba cache when a module its kernel calls into changed.
+
+    Numba's cache of ``_smdp_turns`` embeds the compiled turn kernel and bots of other modules but only
+    checks this file's time stamp; a stale copy would run old code (or crash) after they change.
+    """
+    here = Path(__file__).resolve()
+    cache = here.parent / "__pycache__"
+    deps = ("_kernels.py", "bots.py", "rules.py", "state.py", "observe.py", "smdp.py")
+    h = hashlib.sha256()
+    for name in deps:
+        f = here.parent / name
+        h.update(f.read_bytes() if f.is_file() else b"")
+    stamp = cache / "smdp.deps"
+    digest = h.hexdigest()
+    try:
+        if stamp.is_file() and stamp.read_text() == digest:
+            return
+        for f in cache.glob("smdp.*.nb[ic]"):
+            f.unlink(missing_ok=True)
+        cache.mkdir(exist_ok=True)
+        stamp.write_text(digest)
+    except OSError:  # read-only install: numba then caches elsewhere or not at all
+        pass
+
+
+_purge_stale_cache()
+C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE = range(8)
+_PARALLEL_MIN_BATTLES = 8
+_POOL: list[ThreadPoolExecutor] = []
+
+
+def _pool() -> ThreadPoolExecutor:
+    """A shared thread pool (the kernel releases the GIL)."""
+    if not _POOL:
+        _POOL.append(ThreadPoolExecutor(max(1, numba.get_num_threads())))
+    return _POOL[0]
+
+
+_step_range = getattr(K, "step_range", None)
+if _step_range is None:  # arena kernels before step_range: the same per-battle loop over a range
+
+    @njit(cache=True, nogil=True)
+    def _step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score,  # type: ignore
+                    score_total, placements, placements_total, cmd, params, scratch_i, scratch_f):
+        n, k = rf.shape[2], kf.shape[2]
+        for b in range(b0, b1):
+            if not bb[b, K.DONE]:
+                K._step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                               placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
+                               scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
+
+
+@njit(cache=True)
+def _relative(a: float) -> float:
+    """Angle wrapped to [-pi, pi) (Utils.normalRelativeAngle, as control._rel)."""
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+@njit(cache=True)
+def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, ctrl: np.ndarray, power: float,
+                    cmd: np.ndarray) -> None:
+    """Gun turn, radar turn and fire power of a living learning tank (control.gun_radar_commands' rule).
+
+    The radar turns to the target plus an overshoot, the gun to the target; the tank fires when the gun
+    is within the tolerance, the gun is cold and it has energy; power by distance band, or ``power`` > 0.
+    Without a target the radar spins a full turn and the gun keeps its command.
+    """
+    if tgt < 0:
+        cmd[b, i, 3] = 2 * np.pi
+        cmd[b, i, 4] = 0.0
+        return
+    dx = rf[b, K.X, tgt] - rf[b, K.X, i]
+    dy = rf[b, K.Y, tgt] - rf[b, K.Y, i]
+    bearing = np.arctan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise
+    dist = np.hypot(dx, dy)
+    gun_turn = _relative(bearing - rf[b, K.GH, i])
+    radar_turn = _relative(bearing - rf[b, K.RH, i])
+    radar_turn = radar_turn + np.sign(radar_turn) * ctrl[C_OVERSHOOT]
+    cmd[b, i, 2] = gun_turn
+    cmd[b, i, 3] = radar_turn
+    fire = abs(gun_turn) <= ctrl[C_TOL] and rf[b, K.HEAT, i] == 0 and rf[b, K.E, i] > 0 and ctrl[C_FIRE] > 0
+    if not fire:
+        cmd[b, i, 4] = 0.0
+    elif power > 0:
+        cmd[b, i, 4] = power
+    elif dist < ctrl[C_NEAR]:
+        cmd[b, i, 4] = ctrl[C_PNEAR]
+    elif dist < ctrl[C_FAR]:
+        cmd[b, i, 4] = ctrl[C_PMID]
+    else:
+        cmd[b, i, 4] = ctrl[C_PFAR]
+
+
+@njit(cache=True, nogil=True)
+def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, ctrl,
+                rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
+                placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
+                rewards, max_distance, target, disc, feats):
+    """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
+    t = 0, then kept; gun/radar controller every turn), scripted bots, one Robocode turn, Eq. 35 rewards.
+    Then the observations of those battles' robots into target, disc, feats. Returns the turn index where
+    it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can run
+    in parallel threads."""
+    n = rf.shape[2]
+    for t in range(t0, t1):
+        any_live = False
+        for b in range(b0, b1):
+            if bb[b, K.DONE]:
+                buf[3, b, :] = 0.0
+                continue
+            any_live = True
+            for i in range(n):
+                tg = target_of(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, rule)
+                buf[0, b, i] = tg
+                buf[1, b, i] = rf[b, K.E, i]
+                buf[2, b, i] = rf[b, K.E, tg] if tg >= 0 else 0.0
+                buf[3, b, i] = 1.0 if rb[b, K.ALIVE, i] and tg >= 0 else 0.0
+                if learner[i]:
+                    # moves are written once at the start of the SMDP step (set* semantics), then kept
+                    cmd[b, i, 0] = move[b, i, 0] if t == 0 else np.nan
+                    cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
+                    cmd[b, i, 2] = np.nan
+                    cmd[b, i, 3] = np.nan
+                    cmd[b, i, 4] = 0.0
+                    if rb[b, K.ALIVE, i]:
+                        controller_turn(rf, b, i, tg, ctrl, power[b, i], cmd)
+                else:
+                    for c in range(4):
+                        cmd[b, i, c] = np.nan
+                    cmd[b, i, 4] = 0.0
+        if not any_live:
+            t1 = t
+            break
+        if has_bots:
+            r = slice(b0, b1)
+            bots_step(kinds, mem[r], rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.GH], rf[r, K.RH], rf[r, K.E],
+                      rb[r, K.ALIVE], ri[r, K.TEAM], rf[r, K.DIST], rf[r, K.BODYREM], rf[r, K.GUNREM],
+                      rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
+                      rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
+                      rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem)
+        # one Robocode turn of these battles (what Arena.step runs)
+        _step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                    placements, placements_total, cmd, params, scratch_i, scratch_f)
+        for b in range(b0, b1):
+            for i in range(n):
+                if buf[3, b, i] > 0:
+                    tg = int(buf[0, b, i])
+                    rewards[b, i, t] = reward_eq35_scalar(buf[1, b, i], rf[b, K.E, i], buf[2, b, i],
+                                                          rf[b, K.E, tg], guard)
+    r = slice(b0, b1)
+    observe_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.E], rb[r, K.ALIVE], ri[r, K.TEAM], rule,
+                   max_distance, width, height, target[r], disc[r], feats[r])
+    return t1

@@ -135,3 +135,20 @@ def test_config_errors() -> None:
         ob.ObservationConfig(max_distance=0.0)
     with pytest.raises(ValueError, match="reward_guard"):
         ob.ObservationConfig(reward_guard=0.0)
+
+
+def test_compiled_observe_matches_array_functions() -> None:
+    rng = np.random.default_rng(7)
+    b, r = 5, 6
+    x = rng.uniform(18, 782, (b, r))
+    y = rng.uniform(18, 582, (b, r))
+    h = rng.uniform(0, 2 * np.pi, (b, r))
+    e = rng.uniform(0, 120, (b, r))
+    alive = rng.random((b, r)) > 0.3
+    team = np.array([0, 0, 1, 1, 2, 2])
+    for rule in ("nearest", "weakest"):
+        cfg = ob.ObservationConfig(target=rule, include_position=True)
+        tgt, disc, feats = ob.observe(x, y, h, e, alive, team, (800.0, 600.0), cfg)
+        np.testing.assert_array_equal(tgt, ob.select_targets(x, y, e, alive, team, rule))
+        np.testing.assert_array_equal(disc, ob.discrete_state(x, y, h, tgt, 1000.0))
+        np.testing.assert_allclose(feats, ob.features(x, y, h, e, tgt, 1000.0, (800.0, 600.0)), atol=1e-6)

@@ -1,10 +1,12 @@
 """Compiled turn kernel: one Robocode turn for every battle of a batch (Battle.runTurn order).
 
 Composes the pure rules of :mod:`confront.arena.rules` over the packed arrays of
-:mod:`confront.arena.state`. Battles run in parallel (``prange``); within a battle the engine's
-sequence is followed exactly. ``order_mode`` 0 = Robocode's random processing order drawn from
-the battle's java.util.Random exactly as the engine consumes it; 1 = one shuffle of the movement
-order per turn (cheaper; same rules); 2 = fixed index order (deterministic, for tests).
+:mod:`confront.arena.state`. ``step_range`` releases the GIL, so :class:`confront.arena.core.Arena`
+runs chunks of battles on a thread pool; within a battle the engine's sequence is followed exactly.
+Kernels are compiled without numba's reference counting (``_nrt=False``): they only index arrays.
+``order_mode`` 0 = Robocode's random processing order drawn from the battle's java.util.Random
+exactly as the engine consumes it; 1 = one shuffle of the movement order per turn (same rules);
+2 = fixed index order (deterministic, for tests).
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .rules import (
     BULLET_RADIUS,
@@ -71,7 +73,7 @@ HALT_TURNS = 120  # robots halted when endTimer > 4 * TURNS_DISPLAYED_AFTER_ENDI
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     """perm[:n] = 0..n-1, shuffled like Collections.shuffle when mode == 0 (swap(i-1, nextInt(i)))."""
     for i in range(n):
@@ -85,7 +87,7 @@ def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     return rng
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def skip_shuffle(rng: int, n: int, mode: int) -> int:
     """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
 
@@ -103,7 +105,7 @@ def skip_shuffle(rng: int, n: int, mode: int) -> int:
     return rng
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _reset_inactivity(bi, bf, b, loss):
     """Battle.resetInactiveTurnCount: every 10 energy lost in total restarts the inactivity counter."""
     if loss < 0.0:
@@ -201,7 +203,7 @@ def _remove_from_list(ki, bi, b, pos):
     ki[b, KOWNER, slot] = -1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params, bb_decided):
     """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
     mode = int(params[P_ORDER])
@@ -325,7 +327,7 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
     ki[b, KSTATE, s] = st
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _turn_body(rf, rb, b, i):
     """RobotPeer.updateHeading: at most min(maxTurnRate, 10 - 0.75|v|) deg; gun and radar follow."""
     rem = rf[b, BODYREM, i]
@@ -351,7 +353,7 @@ def _turn_body(rf, rb, b, i):
         rf[b, H, i] = normal_absolute_angle(rf[b, H, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _turn_gun(rf, rb, b, i):
     """RobotPeer.updateGunHeading: at most 20 deg; the radar follows (adjusted if adjustRadarForGun)."""
     rem = rf[b, GUNREM, i]
@@ -368,7 +370,7 @@ def _turn_gun(rf, rb, b, i):
     rf[b, GH, i] = normal_absolute_angle(rf[b, GH, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _turn_radar(rf, b, i):
     """RobotPeer.updateRadarHeading: at most 45 deg."""
     rem = rf[b, RADREM, i]
@@ -382,7 +384,7 @@ def _turn_radar(rf, b, i):
     rf[b, RH, i] = normal_absolute_angle(rf[b, RH, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _move(rf, rb, b, i):
     """RobotPeer.updateMovement: getNewVelocity, overdrive flag, remaining distance, position, box."""
     d = rf[b, DIST, i]
@@ -445,7 +447,7 @@ def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple
     return True, x, y, ang
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, i, zap, params):
     """RobotPeer.performMove for robot i."""
     n = rf.shape[2]
@@ -533,7 +535,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             rf[b, BODYREM, i] = 0.0
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
     n = rf.shape[2]
@@ -747,34 +749,13 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def step_batch(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+@njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
+def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                placements, placements_total, cmd, params, scratch_i, scratch_f):
-    """Advance every battle that is not done by one turn (parallel over battles)."""
-    nbat = rf.shape[0]
+    """Advance battles b0 .. b1-1 that are not done by one turn."""
     n = rf.shape[2]
     k = kf.shape[2]
-    for b in prange(nbat):
-        if bb[b, DONE]:
-            continue
-        perm_r = scratch_i[b, 0]
-        perm_k = scratch_i[b, 1]
-        perm_d = scratch_i[b, 2]
-        dead = scratch_i[b, 3]
-        order = scratch_i[b, 4]
-        _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
-                     placements, placements_total, cmd, params, perm_r[:n], perm_k[:k], perm_d, dead[:n + 1],
-                     scratch_f, order)
-
-
-@njit(cache=True, _nrt=False, error_model="numpy")
-def step_serial(rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
-                placements, placements_total, cmd, params, scratch_i, scratch_f):
-    """Same as step_batch without threads (cheaper for one or a few battles)."""
-    nbat = rf.shape[0]
-    n = rf.shape[2]
-    k = kf.shape[2]
-    for b in range(nbat):
+    for b in range(b0, b1):
         if bb[b, DONE]:
             continue
         _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,

@@ -63,6 +63,9 @@ with ``order="engine"``, every random processing order exactly as the engine dra
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
+from functools import cache
 
 import numpy as np
 
@@ -74,19 +77,39 @@ from .state import FIELDS, ArenaState, allocate
 __all__ = ["Arena", "ORDER_MODES"]
 
 ORDER_MODES = {"engine": 0, "shuffle": 1, "fixed": 2}
-_PARALLEL_MIN_BATTLES = 8
+_PARALLEL_MIN_BATTLES = 16
+
+
+@cache
+def _pool(workers: int) -> ThreadPoolExecutor:
+    """Shared worker threads for the GIL-free kernel."""
+    return ThreadPoolExecutor(max_workers=workers, thread_name_prefix="arena")
+
+
+def default_threads() -> int:
+    """Threads for batched steps: CONFRONT_THREADS, else the CPUs this process may use."""
+    env = os.environ.get("CONFRONT_THREADS")
+    if env is not None:
+        if not env.isdigit() or int(env) < 1:
+            raise ValueError(f"CONFRONT_THREADS must be a positive integer, got {env!r}")
+        return int(env)
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 class Arena:
     """Many independent Robocode battles of one scenario, advanced together one turn per ``step``."""
 
-    def __init__(self, scenario: Scenario | str, n_battles: int = 1, seed: int = 0, order: str = "engine") -> None:
+    def __init__(self, scenario: Scenario | str, n_battles: int = 1, seed: int = 0, order: str = "engine",
+                 threads: int | None = None) -> None:
         if isinstance(scenario, str):
             scenario = get_scenario(scenario)
         if order not in ORDER_MODES:
             raise ValueError(f"order must be one of {sorted(ORDER_MODES)}, got {order!r}")
         self.scenario = scenario
         self.order = order
+        self.threads = default_threads() if threads is None else int(threads)
+        if self.threads < 1:
+            raise ValueError(f"threads must be >= 1, got {threads}")
         self.state: ArenaState = allocate(scenario, int(n_battles))
         b, r = self.n_battles, self.n_robots
         self.params = np.array([scenario.width, scenario.height, scenario.gun_cooling_rate,
@@ -161,10 +184,17 @@ class Arena:
         if not np.all(np.isfinite(cmd[..., 4])):
             raise ValueError("commands[..., 4] (fire power) must be finite; use 0 for no fire")
         p = self.state.packed
-        fn = K.step_batch if self.n_battles >= _PARALLEL_MIN_BATTLES else K.step_serial
-        fn(p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
-           p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
-           p["placements_total"], cmd, self.params, self._scratch_i, self._scratch_f)
+        args = (p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
+                p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
+                p["placements_total"], cmd, self.params, self._scratch_i, self._scratch_f)
+        b, workers = self.n_battles, self.threads
+        if b >= _PARALLEL_MIN_BATTLES and workers > 1:
+            size = -(-b // workers)
+            futures = [_pool(workers).submit(K.step_range, lo, min(b, lo + size), *args) for lo in range(0, b, size)]
+            for f in futures:
+                f.result()
+        else:
+            K.step_range(0, b, *args)
 
     def idle_commands(self) -> np.ndarray:
         """Commands that keep every remaining value and do not fire."""

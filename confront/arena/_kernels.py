@@ -87,14 +87,26 @@ def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     return rng
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
-def skip_shuffle(rng: int, n: int, mode: int) -> int:
-    """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
+def _jump_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """LCG jump-ahead: state after j steps = (A[j] * s + C[j]) mod 2^48 (java.util.Random's generator)."""
+    mult, add, mask = 0x5DEECE66D, 0xB, (1 << 48) - 1
+    a = np.zeros(n + 1, dtype=np.int64)
+    c = np.zeros(n + 1, dtype=np.int64)
+    aj, cj = 1, 0
+    for j in range(n + 1):
+        a[j], c[j] = aj, cj
+        aj, cj = (aj * mult) & mask, (cj * mult + add) & mask
+    return a, c
 
-    Used where the engine's order cannot change the outcome (or is rebuilt lazily when it can).
-    """
-    if mode != 0:
-        return rng
+
+_JUMP_N = 4096
+_JUMP_A, _JUMP_C = _jump_tables(_JUMP_N)
+_MASK48 = (1 << 48) - 1
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _skip_exact(rng: int, n: int) -> int:
+    """skip_shuffle one step at a time, with nextInt's rejection loop."""
     for i in range(n, 1, -1):
         rng, u = java_next(rng, 31)
         if (i & (i - 1)) != 0 and u >= (1 << 31) - i:  # nextInt's rejection is only possible up here
@@ -103,6 +115,27 @@ def skip_shuffle(rng: int, n: int, mode: int) -> int:
                 rng, u = java_next(rng, 31)
                 r = u % i
     return rng
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def skip_shuffle(rng: int, n: int, mode: int) -> int:
+    """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
+
+    Used where the engine's order cannot change the outcome (or is rebuilt lazily when it can). The n-1
+    draws are computed independently by jump-ahead; the rare case where nextInt could reject a draw
+    falls back to the step-by-step loop.
+    """
+    if mode != 0 or n < 2:
+        return rng
+    steps = n - 1
+    if steps > _JUMP_N:
+        return _skip_exact(rng, n)
+    for j in range(1, steps + 1):
+        u = ((_JUMP_A[j] * rng + _JUMP_C[j]) & _MASK48) >> 17
+        i = n - j + 1
+        if u >= (1 << 31) - i and (i & (i - 1)) != 0:
+            return _skip_exact(rng, n)
+    return (_JUMP_A[steps] * rng + _JUMP_C[steps]) & _MASK48
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")

@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from confront.arena import rules as R
@@ -114,3 +115,43 @@ def test_java_random_matches_java():
     s = R.java_seed(42)
     s, k = R.java_next_int(s, 10)
     assert k == 0  # new Random(42).nextInt(10)
+
+
+def _state_before(u31: int, low17: int = 12345) -> int:
+    """A generator state whose next next(31) returns u31 (inverting the LCG)."""
+    mult, mask = 0x5DEECE66D, (1 << 48) - 1
+    after = (u31 << 17) | low17
+    return ((after - 0xB) * pow(mult, -1, 1 << 48)) & mask
+
+
+def _java_next_int_reference(state: int, bound: int) -> tuple[int, int]:
+    """java.util.Random.nextInt(bound) in plain Python, with Java's 32-bit overflow."""
+    def nxt(s):
+        s = (s * 0x5DEECE66D + 0xB) & ((1 << 48) - 1)
+        return s, s >> 17
+    state, r = nxt(state)
+    m = bound - 1
+    if bound & m == 0:
+        return state, (bound * r) >> 31
+    u = r
+    while True:
+        r = u % bound
+        v = (u - r + m) & 0xFFFFFFFF
+        if v < (1 << 31):  # not negative as a Java int
+            return state, r
+        state, u = nxt(state)
+
+
+def test_next_int_rejection_and_skip_match_java():
+    from confront.arena._kernels import shuffle_into, skip_shuffle
+
+    perm = np.zeros(16, dtype=np.int32)
+    for u in ((1 << 31) - 1, (1 << 31) - 3, (1 << 31) - 8, 5, 1 << 30):
+        s = _state_before(u)
+        for bound in (3, 5, 6, 7, 8, 12):
+            assert R.java_next_int(s, bound) == _java_next_int_reference(s, bound)
+        for n in (2, 3, 7, 12):
+            assert skip_shuffle(s, n, 0) == shuffle_into(s, perm, n, 0)
+    # (2^31 - 1) with bound 7 is rejected by Java: one extra draw is consumed
+    s = _state_before((1 << 31) - 1)
+    assert R.java_next_int(s, 7)[0] != R.java_next(s, 31)[0]

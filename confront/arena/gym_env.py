@@ -68,8 +68,8 @@ class AgentDriver:
         self.other_policy = other_policy
         self._full = np.zeros((n_battles, self.env.n_robots), dtype=np.int64)
 
-    def full_actions(self, agent_actions: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-        """(B, R) actions: the agents' (B, n_agents) plus the other learning tanks'."""
+    def full_actions(self, agent_actions: np.ndarray | int, rng: np.random.Generator) -> np.ndarray:
+        """(B, R) actions: the agents' (B, n_agents) (or one int for all) plus the other learning tanks'."""
         a = self._full
         if self.others.size:
             if self.other_policy is None:
@@ -117,7 +117,7 @@ class BattleEnv(gym.Env):
         self.render_scale = render_scale
         self.observation_space = make_observation_space(cfg.observation.n_features)
         self.action_space = spaces.Discrete(cfg.n_actions)
-        self._base_seed = seed
+        self._n_actions = cfg.n_actions
 
     @property
     def team_env(self) -> TeamBattleEnv:
@@ -140,10 +140,11 @@ class BattleEnv(gym.Env):
 
     def step(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
         """Hold the action for T turns."""
-        if not self.action_space.contains(action):
-            raise ValueError(f"action must be in 0..{self.action_space.n - 1}, got {action!r}")
+        a = int(action)
+        if a != action or not 0 <= a < self._n_actions:
+            raise ValueError(f"action must be in 0..{self._n_actions - 1}, got {action!r}")
         drv = self._driver
-        res: StepResult = drv.env.step(drv.full_actions(np.array([[int(action)]]), self.np_random))
+        res: StepResult = drv.env.step(drv.full_actions(a, self.np_random))
         rewards = res.rewards[0, 0]
         terminated = bool(res.terminated[0, 0] and not res.truncated[0])
         truncated = bool(res.truncated[0])

@@ -257,17 +257,20 @@ class TeamBattleEnv:
         a = np.asarray(actions)
         if a.shape != (self.n_battles, self.n_robots):
             raise ValueError(f"actions must have shape ({self.n_battles}, {self.n_robots}), got {a.shape}")
-        if not np.issubdtype(a.dtype, np.integer):
+        if a.dtype.kind not in "iu":
             raise ValueError(f"actions must be integers, got dtype {a.dtype}")
+        if a.size and 0 <= a.min() and a.max() < self.n_actions:
+            return a  # all in range (the common case): nothing to mask
         la = a[:, self.learner]
         if la.size and (la.min() < 0 or la.max() >= self.n_actions):
             raise ValueError(f"actions must be in 0..{self.n_actions - 1}, got [{la.min()}, {la.max()}]")
-        return np.where(self.learner[None, :], a, 0).astype(np.int64)
+        return np.where(self.learner[None, :], a, 0)
 
     def _sync_bots(self) -> None:
         """Scripted bots clear their memory when their battle started a new round (as ScriptedBots.commands)."""
-        bots, rnd = self.bots, self.arena.state.round
+        bots = self.bots
         if bots is not None:
+            rnd = self.arena.state.arrays["round"]
             new_round = rnd != bots._round
             if new_round.any():
                 bots.reset(new_round)
@@ -276,11 +279,14 @@ class TeamBattleEnv:
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
         a = self._check_actions(actions)
-        s, cfg, L = self.arena.state, self.config, self.learner
+        s, cfg = self.arena.state.arrays, self.config
         T = cfg.turns_per_step
-        self._move[...] = self._move_table[a % N_MOVES]
-        self._power[...] = self._powers[a // N_MOVES] if cfg.fire_power_actions else 0.0
-        active = s.alive & L[None, :] & ~s.done[:, None]
+        if cfg.fire_power_actions:
+            self._move[...] = self._move_table[a % N_MOVES]
+            self._power[...] = self._powers[a // N_MOVES]
+        else:
+            self._move[...] = self._move_table[a]
+        active = s["alive"] & self.learner & ~s["done"][:, None]
         rewards = np.zeros((self.n_battles, self.n_robots, T))
         self._sync_bots()
         shape = (self.n_battles, self.n_robots)

@@ -1,0 +1,113 @@
+"""Throughput of the environments: Gymnasium step() calls/s, the vector env's and the SMDP team env's rates.
+
+Usage: ``python benchmarks/env_throughput.py [--seconds 2] [--json]``. Prints a table; with ``--json`` the
+last line is a JSON list of records (``env``, ``scenario``, ``batch``, ``turns_per_step``, ``steps_per_s``
+(step() calls), ``env_steps_per_s`` (battles x steps), ``turns_per_s``, ``robot_turns_per_s``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+
+import gymnasium as gym
+import numpy as np
+
+from confront.arena import gym_env  # noqa: F401 - registers confront/Battle-v0
+from confront.arena.smdp import SMDPConfig, TeamBattleEnv
+from confront.arena.vector_env import BattleVectorEnv
+
+
+def _rate(step: Callable[[int], None], seconds: float) -> float:
+    """step() calls per second over about ``seconds`` (after a warm-up)."""
+    for i in range(20):
+        step(i)
+    n, t0 = 0, time.perf_counter()
+    while True:
+        for _ in range(10):
+            step(n)
+            n += 1
+        dt = time.perf_counter() - t0
+        if dt >= seconds:
+            return n / dt
+
+
+def bench_gym(scenario: str, opponents: str, turns: int, seconds: float) -> dict:
+    env = gym.make("confront/Battle-v0", scenario=scenario, opponents=opponents, turns_per_step=turns,
+                   disable_env_checker=True).unwrapped
+    env.reset(seed=0)
+
+    def step(i: int) -> None:
+        _, _, term, trunc, _ = env.step(i % 4)
+        if term or trunc:
+            env.reset()
+
+    r = _rate(step, seconds)
+    n = env.team_env.n_robots
+    return {"env": "gym", "scenario": scenario, "batch": 1, "turns_per_step": turns, "steps_per_s": r,
+            "env_steps_per_s": r, "turns_per_s": r * turns, "robot_turns_per_s": r * turns * n}
+
+
+def bench_vector(scenario: str, opponents: str, batch: int, turns: int, seconds: float) -> dict:
+    env = BattleVectorEnv(batch, scenario, opponents, turns_per_step=turns, seed=0)
+    env.reset(seed=0)
+    acts = np.random.default_rng(0).integers(0, 4, size=(64, batch))
+
+    def step(i: int) -> None:
+        env.step(acts[i % 64])
+
+    r = _rate(step, seconds)
+    n = env._driver.env.n_robots
+    return {"env": "vector", "scenario": scenario, "batch": batch, "turns_per_step": turns, "steps_per_s": r,
+            "env_steps_per_s": r * batch, "turns_per_s": r * batch * turns,
+            "robot_turns_per_s": r * batch * turns * n}
+
+
+def bench_team(scenario: str, opponents: str, batch: int, turns: int, seconds: float) -> dict:
+    env = TeamBattleEnv(scenario, batch, seed=0, opponents=opponents, config=SMDPConfig(turns_per_step=turns))
+    env.reset()
+    acts = np.random.default_rng(0).integers(0, 4, size=(64, batch, env.n_robots))
+
+    def step(i: int) -> None:
+        env.step(acts[i % 64])
+
+    r = _rate(step, seconds)
+    n = env.n_robots
+    return {"env": "team", "scenario": scenario, "batch": batch, "turns_per_step": turns, "steps_per_s": r,
+            "env_steps_per_s": r * batch, "turns_per_s": r * batch * turns,
+            "robot_turns_per_s": r * batch * turns * n}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=2.0, help="measuring time per row")
+    ap.add_argument("--json", action="store_true", help="print the records as JSON on the last line")
+    args = ap.parse_args()
+    s = args.seconds
+    rows = [
+        bench_gym("1v1", "SpinBot", 10, s),
+        bench_gym("1v1", "SpinBot", 1, s),
+        bench_gym("4v4", "SpinBot", 10, s),
+        bench_vector("1v1", "SpinBot", 64, 10, s),
+        bench_vector("1v1", "SpinBot", 256, 10, s),
+        bench_team("4v4", "td", 1, 10, s),
+        bench_team("4v4", "td", 64, 10, s),
+        bench_team("4v4", "td", 256, 10, s),
+        bench_team("4v4", "SpinBot", 256, 10, s),
+        bench_team("4v10", "td", 256, 10, s),
+    ]
+    head = f"{'env':<7}{'scenario':<9}{'batch':>6}{'T':>4}{'step()/s':>12}{'env-steps/s':>14}{'turns/s':>13}" \
+           f"{'robot-turns/s':>16}"
+    print(head)
+    print("-" * len(head))
+    for r in rows:
+        print(f"{r['env']:<7}{r['scenario']:<9}{r['batch']:>6}{r['turns_per_step']:>4}{r['steps_per_s']:>12,.0f}"
+              f"{r['env_steps_per_s']:>14,.0f}{r['turns_per_s']:>13,.0f}{r['robot_turns_per_s']:>16,.0f}")
+    if args.json:
+        print(json.dumps(rows))
+
+
+if __name__ == "__main__":
+    main()

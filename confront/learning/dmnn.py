@@ -206,7 +206,7 @@ class DMNN(Learner):
         n_in = self.params.n_inputs
         if self.observation == "discrete":
             s = np.asarray(obs).reshape(-1)
-            if not np.issubdtype(s.dtype, np.integer) or (s.size and (s.min() < 0 or s.max() >= n_in)):
+            if s.dtype.kind not in "iu" or (s.size and (s.min() < 0 or s.max() >= n_in)):
                 raise ValueError(f"obs must be integer states in [0, {n_in}) for a discrete DMNN")
             x = np.zeros((s.size, n_in), dtype=self.dtype)
             x[np.arange(s.size), s] = 1.0

@@ -92,7 +92,7 @@ class TabularQ(Learner):
 
     def _states(self, obs: np.ndarray, key: str) -> np.ndarray:
         s = np.asarray(obs).reshape(-1)
-        if not np.issubdtype(s.dtype, np.integer):
+        if s.dtype.kind not in "iu":
             raise ValueError(f"{key} must be integer state indices for a tabular learner, got dtype {s.dtype}")
         if s.size and (s.min() < 0 or s.max() >= self.params.n_states):
             raise ValueError(f"{key} holds a state outside [0, {self.params.n_states})")

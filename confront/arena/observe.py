@@ -61,11 +61,20 @@ class ObservationConfig:
         return 9 if self.include_position else 7
 
 
+@njit(cache=True)
+def float_mod(a: float, m: float) -> float:
+    """a mod m for m > 0 with the sign of m, computed exactly as Python's and NumPy's float % (fmod based)."""
+    r = np.fmod(a, m)
+    if r < 0:
+        r += m
+    return r
+
+
 @vectorize(["float64(float64)"], cache=True)
 def normal_absolute_angle(a: float) -> float:
     """Angle in [0, 2*pi) (a NumPy ufunc; also callable on scalars in compiled code)."""
     # Robocode Utils.normalAbsoluteAngle
-    r = a % TWO_PI
+    r = float_mod(a, TWO_PI)
     return 0.0 if r >= TWO_PI else r
 
 

@@ -39,6 +39,7 @@ from .observe import (
     TARGET_RULES,
     ObservationConfig,
     field_diagonal,
+    float_mod,
     observe,
     observe_kernel,
     reward_eq35_scalar,
@@ -417,7 +418,7 @@ if _step_range is None:  # arena kernels before step_range: the same per-battle 
 @njit(cache=True)
 def _relative(a: float) -> float:
     """Angle wrapped to [-pi, pi) (Utils.normalRelativeAngle, as control._rel)."""
-    return (a + np.pi) % (2 * np.pi) - np.pi
+    return float_mod(a + np.pi, 2 * np.pi) - np.pi
 
 
 @njit(cache=True)

@@ -123,3 +123,30 @@ def test_bad_input_errors() -> None:
         resolve_drivers(get_scenario("1v1"), "Nobody")
     with pytest.raises(ValueError, match="turns_per_step"):
         SMDPConfig(turns_per_step=0)
+
+
+def test_compiled_controller_matches_control_module() -> None:
+    from confront.arena import _kernels as K
+    from confront.arena.control import ControlConfig, gun_radar_commands
+    from confront.arena.smdp import controller_turn
+
+    env = TeamBattleEnv("4v4", n_battles=4, seed=8, opponents="td")
+    env.reset()
+    for a in np.random.default_rng(2).integers(0, 4, size=(25, 4, 8)):
+        env.step(a)  # a mix of positions, headings, gun heat and energies
+    s = env.arena.state
+    s.gun_heat[:, ::2] = 0.0
+    tgt = env.observe()[0]
+    cfg = ControlConfig()
+    ref = gun_radar_commands(env.arena, env.arena.idle_commands(), cfg, target=tgt)
+    out = env.arena.idle_commands()
+    rf = env.arena.state.packed["rf"]
+    for b in range(4):
+        for i in range(8):
+            if s.alive[b, i]:
+                controller_turn(rf, b, i, int(tgt[b, i]), env._ctrl, 0.0, out)
+    # equal up to the last bit of arctan2 (NumPy's and LLVM's libm may differ by one ulp)
+    np.testing.assert_allclose(out[..., :4], ref[..., :4], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(out[..., 4], ref[..., 4])
+    assert (ref[..., 4] > 0).any()  # some tanks fire
+    assert K.X == 0  # the kernel reads the packed arrays by these positions

@@ -255,3 +255,37 @@ def write_html(replay: Replay, path: str | Path, title: str | None = None) -> Pa
 
 def _escape(s: str) -> str:
     return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+REPLAY_SUFFIXES = (".replay.json", ".replay.json.gz")
+
+
+def find_replays(source: str | Path) -> list[Path]:
+    """Replay files named by ``source``: the file itself, or every ``*.replay.json[.gz]`` under a run folder."""
+    p = Path(source)
+    if p.is_file():
+        return [p]
+    if p.is_dir():
+        return sorted(f for f in p.rglob("*") if f.is_file() and f.name.endswith(REPLAY_SUFFIXES))
+    raise ValueError(f"replay source {str(source)!r} is neither a file nor a folder")
+
+
+def export_replays(source: str | Path, out_dir: str | Path | None = None, gif: bool = True,
+                   html: bool = True) -> list[Path]:
+    """Write a GIF and an HTML player beside each replay of ``source`` (or into ``out_dir``); the paths."""
+    written: list[Path] = []
+    files = find_replays(source)
+    if not files:
+        raise ValueError(f"no *.replay.json[.gz] files under {str(source)!r}")
+    for f in files:
+        rep = load_replay(f)
+        stem = f.name
+        for suffix in (".gz", ".json", ".replay"):
+            stem = stem.removesuffix(suffix)
+        folder = Path(out_dir) if out_dir is not None else f.parent
+        folder.mkdir(parents=True, exist_ok=True)
+        if gif:
+            written.append(write_gif(rep, folder / f"{stem}.gif"))
+        if html:
+            written.append(write_html(rep, folder / f"{stem}.html", title=f"confront replay {stem}"))
+    return written

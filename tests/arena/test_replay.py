@@ -113,3 +113,19 @@ def test_html_player_in_headless_chromium(tmp_path: Path) -> None:
     for colour in TEAM_COLOURS[:2]:  # both teams' tanks are on screen
         hits = np.all(np.abs(img - np.array(colour)) <= 3, axis=-1).sum()
         assert hits > 100, colour
+
+
+def test_export_replays_from_a_run_folder(tmp_path: Path) -> None:
+    run = tmp_path / "run" / "replays"
+    run.mkdir(parents=True)
+    _synthetic(10).save(run / "round1.replay.json.gz")
+    _synthetic(10).save(run / "round2.replay.json")
+    (run / "other.json").write_text("{}")
+    from confront.arena.replay import export_replays, find_replays
+
+    assert [p.name for p in find_replays(tmp_path / "run")] == ["round1.replay.json.gz", "round2.replay.json"]
+    out = export_replays(tmp_path / "run", tmp_path / "out")
+    assert sorted(p.name for p in out) == ["round1.gif", "round1.html", "round2.gif", "round2.html"]
+    assert "__REPLAY_JSON__" not in (tmp_path / "out" / "round1.html").read_text()
+    with pytest.raises(ValueError, match="neither"):
+        find_replays(tmp_path / "missing")

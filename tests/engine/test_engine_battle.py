@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import signal
 import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 
@@ -40,3 +44,34 @@ def test_sample_battle_matches_engine_results_file(install: EngineInstall, tmp_p
     assert {r.name for r in res.robots} == {"sample.SpinBot", "sample.Walls"}
     assert run.skipped_turns == {}
     assert run.robot_turns >= run.turns  # both alive for most turns
+
+
+def _children(pid: int) -> list[int]:
+    out = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        text = (task / "children").read_text().split()
+        out += [int(c) for c in text]
+    return out
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+def test_ctrl_c_stops_the_engine(install, tmp_path) -> None:
+    code = ("from confront.engine.battle import BattleSpec\n"
+            "from confront.engine.runner import run_battle\n"
+            "run_battle(BattleSpec(('SpinBot', 'Walls'), rounds=500))\n")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    java: list[int] = []
+    deadline = time.monotonic() + 60
+    while not java and time.monotonic() < deadline:  # wait for the engine process to start
+        java = [c for c in _children(proc.pid) if "java" in Path(f"/proc/{c}/cmdline").read_bytes().decode()]
+        time.sleep(0.1)
+    assert java, "the engine did not start"
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode != 0 and b"KeyboardInterrupt" in err
+    for _ in range(50):  # the kill is immediate; give the kernel a moment to reap
+        if not Path(f"/proc/{java[0]}").exists():
+            break
+        time.sleep(0.1)
+    assert not Path(f"/proc/{java[0]}").exists()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from typing import Any
 
 from confront.engine.battle import scenario_battle
 from confront.engine.runner import EngineOptions, run_battle
@@ -19,7 +20,7 @@ def engine_throughput(
     opponents: Sequence[str] = DEFAULT_OPPONENTS,
     seed: int = 1,
     cpu_constant_ms: float = 2.7,
-) -> dict:
+) -> dict[str, Any]:
     """Play ``rounds`` rounds of a scenario with sample robots headless and measure the engine's speed.
 
     ``turns_per_s`` and ``robot_turns_per_s`` are over the battle inside the JVM (all turns, including the

@@ -27,6 +27,7 @@ import sys
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 PROTOCOL_VERSION = 1
 LOOPBACK = "127.0.0.1"
@@ -70,7 +71,7 @@ class Observation:
     width: float
     height: float
     scans: tuple[Scan, ...] = ()
-    events: tuple[dict, ...] = ()
+    events: tuple[dict[str, Any], ...] = ()
 
     def enemies(self) -> tuple[Scan, ...]:
         """Scans of robots that are not team-mates."""
@@ -80,21 +81,21 @@ class Observation:
 Action = Sequence[float]
 Policy = Callable[[Observation], Action]
 
-def _num(d: dict, key: str) -> float:
+def _num(d: dict[str, Any], key: str) -> float:
     v = d.get(key)
     if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
         raise ValueError(f"bad or missing number {key!r}: {v!r}")
     return float(v)
 
 
-def _check_version(msg: dict, kind: str) -> None:
+def _check_version(msg: dict[str, Any], kind: str) -> None:
     if msg.get("v") != PROTOCOL_VERSION:
         raise ValueError(f"protocol version {msg.get('v')!r} != {PROTOCOL_VERSION}")
     if msg.get("type") != kind:
         raise ValueError(f"expected a {kind!r} message, got type {msg.get('type')!r}")
 
 
-def parse_hello(line: str, token: str) -> dict:
+def parse_hello(line: str, token: str) -> dict[str, Any]:
     """Validate a hello line; returns the message."""
     msg = json.loads(line)
     if not isinstance(msg, dict):
@@ -119,7 +120,7 @@ def _finite(text: str, what: str) -> float:
 _OBS_FIELDS = 13
 
 
-def parse_observation(line: str, hello: dict) -> Observation:
+def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
     """Validate one ``O ...`` line (from the robot introduced by ``hello``) into an :class:`Observation`."""
     parts = line.split("\t")
     head = parts[0].split(" ")
@@ -134,7 +135,7 @@ def parse_observation(line: str, hello: dict) -> Observation:
         if len(f) != 10 or f[2] not in ("0", "1"):
             raise ValueError(f"bad scan: {item[:80]!r}")
         scans.append(Scan(f[0], int(f[1]), f[2] == "1", *(_finite(v, "scan value") for v in f[3:])))
-    events: tuple[dict, ...] = ()
+    events: tuple[dict[str, Any], ...] = ()
     if parts[2] != "[]":
         raw = json.loads(parts[2])
         if not isinstance(raw, list) or not all(isinstance(e, dict) for e in raw):
@@ -250,7 +251,7 @@ class BridgeServer:
             self.stats.errors.append(text)
 
     def _serve(self, sock: socket.socket) -> None:
-        hello: dict | None = None
+        hello: dict[str, Any] | None = None
         try:
             with sock, sock.makefile("r", encoding="utf-8", newline="\n") as lines:
                 for line in lines:

@@ -14,6 +14,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from confront.engine.battle import BattleSpec
 from confront.engine.install import ENGINE_VERSION
@@ -206,7 +207,7 @@ BATTLES: tuple[ScriptedBattle, ...] = (
 )
 
 
-def record(battle: ScriptedBattle, out: Path, cpu_constant_ms: float = 20.0) -> dict:
+def record(battle: ScriptedBattle, out: Path, cpu_constant_ms: float = 20.0) -> dict[str, Any]:
     """Play ``battle`` in the engine, write its self-describing trace to ``out``, return run facts."""
     scripts = {f"script_{i + 1}.txt": r.script_text() for i, r in enumerate(battle.robots)}
     raw = out.with_suffix(".raw.jsonl")
@@ -238,7 +239,7 @@ def record(battle: ScriptedBattle, out: Path, cpu_constant_ms: float = 20.0) -> 
         })
     # robots print their events while the engine moves on, so a line may hold events of the turn before;
     # put every event on the line of the turn it happened in (its "time"), robots in index order
-    events: dict[int, list[dict]] = {}
+    events: dict[int, list[dict[str, Any]]] = {}
     for ln in lines[1:]:
         for ev in ln.get("events", []):
             events.setdefault(ev["time"], []).append(ev)
@@ -258,7 +259,7 @@ def record(battle: ScriptedBattle, out: Path, cpu_constant_ms: float = 20.0) -> 
     return {"name": battle.name, "turns": run.turns, "skipped": run.skipped_turns, "bytes": out.stat().st_size}
 
 
-def _new_bullet_states(bullets: list[dict], seen: set[tuple[int, int, str]]) -> list[dict]:
+def _new_bullet_states(bullets: list[dict[str, Any]], seen: set[tuple[int, int, str]]) -> list[dict[str, Any]]:
     """Flying bullets every turn; a finished bullet (hit, wall, explosion) only in the turn it changed state."""
     kept = []
     for b in bullets:

@@ -11,6 +11,7 @@ import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from confront.engine.battle import BattleSpec
 from confront.engine.install import JVM_FLAGS, EngineInstall, find_engine
@@ -59,7 +60,7 @@ class EngineRun:
     errors: tuple[str, ...] = ()
     trace: Path | None = None
     stopped_at_turn: int = -1
-    summary: dict = field(default_factory=dict, repr=False)
+    summary: dict[str, Any] = field(default_factory=dict, repr=False)
 
 
 def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: EngineOptions) -> list[str]:
@@ -103,7 +104,7 @@ def run_process(cmd: Sequence[str], timeout_s: float, cwd: Path, log: Path) -> i
                 proc.wait()
 
 
-def _row(d: dict, name: str, team: str) -> ScoreRow:
+def _row(d: dict[str, Any], name: str, team: str) -> ScoreRow:
     s = d["score"]
     return ScoreRow(
         name=name, total=s["total"], survival=s["survival"], surv_bonus=s["surv_bonus"],
@@ -112,7 +113,7 @@ def _row(d: dict, name: str, team: str) -> ScoreRow:
     )
 
 
-def results_from_summary(summary: dict, rounds: int) -> BattleResults:
+def results_from_summary(summary: dict[str, Any], rounds: int) -> BattleResults:
     """Exact score parts (doubles from the engine's score snapshots) as :class:`BattleResults`."""
     conts = [_row(c, c["name"], c["name"]) for c in summary["contestants"]]
     by_index = {i: c.name for i, c in enumerate(conts)}

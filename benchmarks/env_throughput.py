@@ -2,7 +2,9 @@
 
 Usage: ``python benchmarks/env_throughput.py [--seconds 2] [--json]``. Prints a table; with ``--json`` the
 last line is a JSON list of records (``env``, ``scenario``, ``batch``, ``turns_per_step``, ``steps_per_s``
-(step() calls), ``env_steps_per_s`` (battles x steps), ``turns_per_s``, ``robot_turns_per_s``).
+(step() calls), ``env_steps_per_s`` (battles x steps), ``turns_per_s``, ``robot_turns_per_s``,
+``steps_per_cpu_s`` (step() calls per second of the process' CPU time: with threads above the wall rate,
+on a busy machine a steadier figure for single-threaded rows)).
 """
 
 from __future__ import annotations
@@ -19,18 +21,22 @@ from confront.arena import gym_env  # noqa: F401 - registers confront/Battle-v0
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.vector_env import BattleVectorEnv
 
+CPU_RATES: list[float] = []  # step() calls per second of this process' CPU time, one per _rate call
+
 
 def _rate(step: Callable[[int], None], seconds: float) -> float:
-    """step() calls per second over about ``seconds`` (after a warm-up)."""
+    """step() calls per wall-clock second over about ``seconds`` (after a warm-up); the rate per CPU second
+    (less sensitive to other processes on a busy machine) goes to CPU_RATES."""
     for i in range(20):
         step(i)
-    n, t0 = 0, time.perf_counter()
+    n, t0, c0 = 0, time.perf_counter(), time.process_time()
     while True:
         for _ in range(10):
             step(n)
             n += 1
         dt = time.perf_counter() - t0
         if dt >= seconds:
+            CPU_RATES.append(n / max(time.process_time() - c0, 1e-9))
             return n / dt
 
 
@@ -98,13 +104,16 @@ def main() -> None:
         bench_team("4v4", "SpinBot", 256, 10, s),
         bench_team("4v10", "td", 256, 10, s),
     ]
+    for r, cpu in zip(rows, CPU_RATES, strict=True):
+        r["steps_per_cpu_s"] = cpu
     head = f"{'env':<7}{'scenario':<9}{'batch':>6}{'T':>4}{'step()/s':>12}{'env-steps/s':>14}{'turns/s':>13}" \
-           f"{'robot-turns/s':>16}"
+           f"{'robot-turns/s':>16}{'step()/cpu-s':>14}"
     print(head)
     print("-" * len(head))
     for r in rows:
         print(f"{r['env']:<7}{r['scenario']:<9}{r['batch']:>6}{r['turns_per_step']:>4}{r['steps_per_s']:>12,.0f}"
-              f"{r['env_steps_per_s']:>14,.0f}{r['turns_per_s']:>13,.0f}{r['robot_turns_per_s']:>16,.0f}")
+              f"{r['env_steps_per_s']:>14,.0f}{r['turns_per_s']:>13,.0f}{r['robot_turns_per_s']:>16,.0f}"
+              f"{r['steps_per_cpu_s']:>14,.0f}")
     if args.json:
         print(json.dumps(rows))
 

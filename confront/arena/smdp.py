@@ -262,17 +262,13 @@ class TeamBattleEnv:
 
     # ------------------------------------------------------------------ stepping
     def _check_actions(self, actions: np.ndarray) -> np.ndarray:
+        """Shape and dtype checks; (B, R) int64 view or copy."""
         a = np.asarray(actions)
         if a.shape != (self.n_battles, self.n_robots):
             raise ValueError(f"actions must have shape ({self.n_battles}, {self.n_robots}), got {a.shape}")
         if a.dtype.kind not in "iu":
             raise ValueError(f"actions must be integers, got dtype {a.dtype}")
-        if a.size and 0 <= a.min() and a.max() < self.n_actions:
-            return a  # all in range (the common case): nothing to mask
-        la = a[:, self.learner]
-        if la.size and (la.min() < 0 or la.max() >= self.n_actions):
-            raise ValueError(f"actions must be in 0..{self.n_actions - 1}, got [{la.min()}, {la.max()}]")
-        return np.where(self.learner[None, :], a, 0)
+        return a if a.dtype == np.int64 else a.astype(np.int64)
 
     def _sync_bots(self) -> None:
         """Scripted bots clear their memory when their battle started a new round (as ScriptedBots.commands)."""
@@ -287,14 +283,13 @@ class TeamBattleEnv:
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
         a = self._check_actions(actions)
-        s, cfg = self.arena.state.arrays, self.config
-        T = cfg.turns_per_step
-        if cfg.fire_power_actions:
-            self._move[...] = self._move_table[a % N_MOVES]
-            self._power[...] = self._powers[a // N_MOVES]
-        else:
-            self._move[...] = self._move_table[a]
-        active = s["alive"] & self.learner & ~s["done"][:, None]
+        T = self.config.turns_per_step
+        active = np.empty((self.n_battles, self.n_robots), dtype=np.bool_)
+        p = self.arena.state.packed
+        if _prepare(a, self.learner, p["rb"], p["bb"], self._move_table, self._powers,
+                    self.config.fire_power_actions, self.n_actions, self._move, self._power, active):
+            la = a[:, self.learner]
+            raise ValueError(f"actions must be in 0..{self.n_actions - 1}, got [{la.min()}, {la.max()}]")
         rewards = np.zeros((self.n_battles, self.n_robots, T))
         self._sync_bots()
         shape = (self.n_battles, self.n_robots)
@@ -396,6 +391,28 @@ def _purge_stale_cache() -> None:
 
 _purge_stale_cache()
 C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE = range(8)
+
+
+@njit(cache=True)
+def _prepare(actions: np.ndarray, learner: np.ndarray, rb: np.ndarray, bb: np.ndarray, table: np.ndarray,
+             powers: np.ndarray, fire_power: bool, n_actions: int, move: np.ndarray, power: np.ndarray,
+             active: np.ndarray) -> bool:
+    """Learning tanks' move (distance, body turn) and fire power for the step, and ``active`` (a learning
+    tank alive in a battle not done). Returns True, changing nothing, if an action is out of range."""
+    nb, n = actions.shape
+    for b in range(nb):
+        for i in range(n):
+            if learner[i] and not 0 <= actions[b, i] < n_actions:
+                return True
+    for b in range(nb):
+        for i in range(n):
+            a = actions[b, i] if learner[i] else 0
+            move[b, i, 0] = table[a % N_MOVES, 0]
+            move[b, i, 1] = table[a % N_MOVES, 1]
+            power[b, i] = powers[a // N_MOVES] if fire_power else 0.0
+            active[b, i] = learner[i] and rb[b, K.ALIVE, i] and not bb[b, K.DONE]
+    return False
+
 _PARALLEL_MIN_BATTLES = 8
 _POOL: list[ThreadPoolExecutor] = []
 

@@ -180,13 +180,13 @@ def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | N
                         seed=cfg.train.seed + 1000 if seed is None else seed,
                         opponents="td" if side.opponent is not None else cfg.opponent.kind,
                         config=smdp_config(cfg))
-    if not hasattr(env, "record"):
-        return None
     loop = Loop(env, Side(side.learner, side.ours, side.opponent, side.theirs), seed=cfg.train.seed, learning=False)
-    replay = env.record(0)
+    env.start_recording(0)
     while loop.rounds_done < 1:
         loop.step()
-    env.record(None)
+    replay = env.stop_recording()
+    if replay is None:
+        return None
     out_dir.mkdir(parents=True, exist_ok=True)
     path = replay.save(out_dir / "last_round.json")
     rp.write_gif(replay, out_dir / "last_round.gif")

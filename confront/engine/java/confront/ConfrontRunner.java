@@ -49,6 +49,7 @@ public final class ConfrontRunner extends BattleAdaptor {
     private long turns;
     private long robotTurns;
     private final List<Integer> roundTurns = new ArrayList<>();
+    private final StringBuilder roundScores = new StringBuilder();
     private final Map<String, Integer> skipped = new LinkedHashMap<>();
     private final List<String> errors = new ArrayList<>();
     private final List<String> messages = new ArrayList<>();
@@ -210,9 +211,33 @@ public final class ConfrontRunner extends BattleAdaptor {
     @Override
     public void onRoundEnded(RoundEndedEvent event) {
         roundTurns.add(event.getTurns());
+        if (last != null && abortedAt < 0) {
+            roundScore(event.getRound(), event.getTurns(), last);
+        }
         if (trace != null && last != null && abortedAt < 0) {
             writeScores("round_end", event.getRound(), event.getTurns(), last);
         }
+    }
+
+    /** Per robot the round's own score parts (exact doubles) and whether it is alive at the round's end. */
+    private void roundScore(int round, int turns, ITurnSnapshot snap) {
+        if (roundScores.length() > 0) {
+            roundScores.append(',');
+        }
+        roundScores.append("{\"round\":").append(round).append(",\"turns\":").append(turns)
+                .append(",\"robots\":[");
+        IRobotSnapshot[] rs = snap.getRobots();
+        for (int i = 0; i < rs.length; i++) {
+            if (i > 0) {
+                roundScores.append(',');
+            }
+            roundScores.append("{\"contestant\":").append(rs[i].getContestantIndex())
+                    .append(",\"alive\":").append(rs[i].getState() != robocode.control.snapshot.RobotState.DEAD)
+                    .append(",\"current\":");
+            current(roundScores, rs[i].getScoreSnapshot());
+            roundScores.append('}');
+        }
+        roundScores.append("]}");
     }
 
     private void writeScores(String type, int round, int turns, ITurnSnapshot snap) {
@@ -334,6 +359,7 @@ public final class ConfrontRunner extends BattleAdaptor {
                 .append(",\"elapsed_s\":").append(elapsed)
                 .append(",\"setup_s\":").append(setupNanos / 1e9)
                 .append(",\"round_turns\":").append(roundTurns.toString())
+                .append(",\"round_scores\":[").append(roundScores).append(']')
                 .append(",\"skipped_turns\":{");
         boolean first = true;
         for (Map.Entry<String, Integer> e : skipped.entrySet()) {

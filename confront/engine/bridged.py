@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from confront.engine.battle import BattleSpec
@@ -83,15 +84,18 @@ def run_bridged_battle(
     timeout_ms: int | None = None,
     workdir: str | os.PathLike[str] | None = None,
     every: int = 1,
+    extra_robots: Sequence[str | os.PathLike[str]] = (),
 ) -> BridgedRun:
     """Run ``spec`` (whose contestants include BridgeBot tanks) with ``policy`` deciding for every BridgeBot.
 
     The robots skip turn 1 (they act once before connecting) and then ask ``policy`` every ``every`` turns.
+    ``extra_robots``: robot jars or folders to add (e.g. exported PolicyBot opponents).
     """
     opts = options or EngineOptions(cpu_constant_ms=BRIDGE_CPU_CONSTANT_MS)
     tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)
     with BridgeServer(policy) as server:
-        run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo, every), workdir=workdir)
+        run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo, every), workdir=workdir,
+                         extra_robots=extra_robots)
     mean_rtt, slow = rtt_stats(run)
     return BridgedRun(run=run, decisions=server.stats.decisions, connections=server.stats.connections,
                       server_errors=tuple(server.stats.errors), failures=bridge_failures(run),

@@ -1,0 +1,193 @@
+"""Training a config's learner live in the real engine (``confront train --engine robocode``).
+
+One battle of ``train.rounds`` rounds: our side is a team of BridgeBots sharing one learner through the bridge
+(parameter sharing), the opponents are sample robots or the frozen TD team exported as PolicyBots. The run
+folder is the simulator's: config.toml, metrics/rounds.csv (same columns), metrics/sessions.csv, model/,
+plots/, summary.json (same keys, plus the engine's skipped turns and bridge failures), and engine/results.txt
+and results.csv (the engine's results for the whole battle). Per-round score parts come from the runner's
+``round_scores`` (each robot's own round score at the round's end).
+No checkpoints: an interrupted engine run starts again from scratch.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from confront.arena.observe import ObservationConfig
+from confront.arena.state import SCORE_PARTS
+from confront.config import to_dict
+from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
+from confront.engine.bridge import Action, Observation
+from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
+from confront.engine.evaluate import _single_star
+from confront.engine.export import ExportedPolicy, export_robot
+from confront.engine.learner_policy import LearnerPolicy
+from confront.engine.runner import EngineOptions
+from confront.experiments.spec import ExperimentConfig
+from confront.experiments.train import _plots, build_learner, save_model, session_rows, td_team
+from confront.runs import Run
+
+__all__ = ["train_in_engine", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
+
+# simulator score part -> the engine's score snapshot key [Robocode RobotStatistics; ram_dmg already x2]
+ENGINE_PARTS: dict[str, str] = {
+    "survival": "survival", "last_survivor": "surv_bonus", "bullet_damage": "bullet_dmg",
+    "bullet_kill_bonus": "bullet_bonus", "ram_damage": "ram_dmg", "ram_kill_bonus": "ram_bonus",
+}
+POLICY_BOT = "confront.PolicyBot*"
+N_MOVES = 4  # the paper's four macro moves; the engine's robots know no fire-power actions
+
+
+def round_rows(round_scores: list[dict[str, Any]], ours: int = 0) -> list[dict[str, Any]]:
+    """Rows of ``metrics/rounds.csv`` (the simulator's columns) from the runner's per-round scores.
+
+    ``ours`` is our contestant index; every other contestant is theirs. A round is decided when at most one
+    contestant has a robot alive at its end.
+    """
+    rows: list[dict[str, Any]] = []
+    for i, rnd in enumerate(round_scores):
+        robots = rnd["robots"]
+        mine = [r for r in robots if r["contestant"] == ours]
+        other = [r for r in robots if r["contestant"] != ours]
+        if not mine or not other:
+            raise ValueError(f"round {rnd.get('round')} has no robots of contestant {ours} or no opponents")
+        alive_o = sum(bool(r["alive"]) for r in mine)
+        alive_t = sum(bool(r["alive"]) for r in other)
+        decided = len({r["contestant"] for r in robots if r["alive"]}) <= 1
+        parts_o = {p: sum(float(r["current"][k]) for r in mine) for p, k in ENGINE_PARTS.items()}
+        parts_t = {p: sum(float(r["current"][k]) for r in other) for p, k in ENGINE_PARTS.items()}
+        total_o, total_t = sum(parts_o.values()), sum(parts_t.values())
+        row: dict[str, Any] = {"battle": 0, "turns": int(rnd["turns"]), "decided": decided,
+                               "score_ours": total_o, "score_theirs": total_t,
+                               "score_ratio": total_o / (total_o + total_t) if total_o + total_t > 0 else 0.5,
+                               # defensive score: survival + last-survivor bonus, as the simulator's rows
+                               "defensive_ours": parts_o["survival"] + parts_o["last_survivor"],
+                               "defensive_theirs": parts_t["survival"] + parts_t["last_survivor"],
+                               "won": decided and alive_o > 0, "alive_ours": alive_o, "alive_theirs": alive_t}
+        for p in SCORE_PARTS:
+            row[f"{p}_ours"] = parts_o[p]
+            row[f"{p}_theirs"] = parts_t[p]
+        row["round"] = i + 1
+        rows.append(row)
+    return rows
+
+
+def _opponent(cfg: ExperimentConfig, obs_cfg: ObservationConfig, robots: Path,
+              progress: bool) -> tuple[str, list[Path], dict[str, Any]]:
+    """The opponents' robot name, extra robot folders and summary info ('td': the TD team as PolicyBots)."""
+    kind = cfg.opponent.kind
+    if kind != "td":
+        return robot_class(kind), [], {}
+    td, where = td_team(cfg, N_MOVES, progress=progress)
+    policy = ExportedPolicy("qtable", q=np.asarray(td.q, dtype=np.float64), observation=obs_cfg,
+                            step_turns=cfg.arena.decision_turns)
+    folder = export_robot(policy, robots)
+    info: dict[str, Any] = {"td_model": str(where)}
+    if cfg.opponent.learning:
+        info["td_learning_ignored"] = True  # the exported TD team plays its frozen table
+    return POLICY_BOT.rstrip("*"), [folder], info
+
+
+def _check(cfg: ExperimentConfig) -> None:
+    if cfg.arena.scenario not in SCENARIO_SIZES:
+        raise ValueError(f"arena.scenario = {cfg.arena.scenario!r}: the engine plays {sorted(SCENARIO_SIZES)}")
+    if cfg.arena.fire_power_actions:
+        raise ValueError("arena.fire_power_actions = true is not supported in the engine (4 moves only)")
+    if cfg.opponent.kind != "td":
+        try:
+            robot_class(cfg.opponent.kind)
+        except ValueError as exc:
+            raise ValueError(f"opponent.kind: {exc}") from None
+    if cfg.transfer.source:
+        raise ValueError("transfer.source is not supported in the engine; train the transfer arm in the simulator")
+
+
+class _Progress:
+    """Bridge policy wrapper that advances a progress bar as rounds end."""
+
+    def __init__(self, policy: LearnerPolicy, rounds: int, desc: str, show: bool) -> None:
+        from tqdm import tqdm
+
+        self.policy = policy
+        self.bar = tqdm(total=rounds, desc=desc, unit="round", disable=not show, dynamic_ncols=True)
+        self.seen = -1
+
+    def __call__(self, obs: Observation) -> Action:
+        if obs.round > self.seen:
+            self.bar.update(max(0, obs.round - max(self.seen, 0)))
+            self.seen = obs.round
+        return self.policy(obs)
+
+    def end_episode(self, robot: str, round_: int) -> None:
+        self.policy.end_episode(robot, round_)
+
+
+def _battle(cfg: ExperimentConfig, opponent: str) -> BattleSpec:
+    spec = scenario_battle(cfg.arena.scenario, BRIDGE_BOT.rstrip("*"), opponent, rounds=cfg.train.rounds)
+    return _single_star(_single_star(spec, BRIDGE_BOT), POLICY_BOT)
+
+
+def train_in_engine(
+    cfg: ExperimentConfig,
+    out: str | Path,
+    progress: bool = True,
+    cpu_constant_ms: float = BRIDGE_CPU_CONSTANT_MS,
+    exist_ok: bool = False,
+) -> dict[str, Any]:
+    """Train ``cfg``'s learner for ``train.rounds`` rounds in the real engine into the run folder ``out``.
+
+    Returns the summary (train_run's keys plus ``engine``, ``skipped_turns``, ``bridge_failures``,
+    ``bridge_errors``, ``updates``, ``rtt_mean_us``, ``cpu_constant_ms``). Bad config values raise ValueError.
+    """
+    _check(cfg)
+    start = time.time()
+    obs_cfg = ObservationConfig(target=cfg.arena.target)
+    learner = build_learner(cfg, obs_cfg.n_features, N_MOVES)
+    run = Run.create(Path(out), to_dict(cfg), exist_ok=exist_ok)
+    policy = LearnerPolicy(learner, np.random.default_rng([cfg.train.seed, 0]), train=True, explore=True,
+                           observation=obs_cfg, step_turns=cfg.arena.decision_turns)
+    # a long training battle gets time: 10 s per round on top of the default limit
+    opts = EngineOptions(seed=cfg.train.seed, cpu_constant_ms=cpu_constant_ms)
+    opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * cfg.train.rounds)
+    with tempfile.TemporaryDirectory(prefix="confront-train-") as tmp:
+        opponent, extra, info = _opponent(cfg, obs_cfg, Path(tmp) / "robots", progress)
+        wrapped = _Progress(policy, cfg.train.rounds, f"{cfg.name} {cfg.arena.scenario} (robocode)", progress)
+        try:
+            res: BridgedRun = run_bridged_battle(_battle(cfg, opponent), wrapped, opts, extra_robots=extra)
+        finally:
+            wrapped.bar.close()
+    rows = round_rows(res.run.summary["round_scores"])
+    (run.path / "engine").mkdir(exist_ok=True)
+    (run.path / "engine" / "results.txt").write_text(res.run.results_text)  # the engine's own results file
+    (run.path / "engine" / "results.csv").write_text(res.run.results.to_csv())
+    sessions = session_rows(rows, cfg.train.session_rounds)
+    run.write_table("rounds", rows)
+    run.write_table("sessions", sessions)
+    save_model(run.path / "model", learner,
+               {"scenario": cfg.arena.scenario, "decision_turns": cfg.arena.decision_turns,
+                "fire_power_actions": False, "target": cfg.arena.target, "engine": "robocode"})
+    figures = _plots(run, rows, sessions, cfg)
+    tail = rows[-min(100, len(rows)):]
+    o, t = sum(r["score_ours"] for r in tail), sum(r["score_theirs"] for r in tail)
+    summary: dict[str, Any] = {
+        "name": cfg.name, "run": str(run.path), "scenario": cfg.arena.scenario, "rounds": len(rows),
+        "sessions": len(sessions), "decisions": policy.decisions,
+        "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
+        "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
+        "score_ours": sum(r["score_ours"] for r in rows), "score_theirs": sum(r["score_theirs"] for r in rows),
+        "learner": learner.diagnostics(), "wall_time_s": time.time() - start,
+        "figures": [str(f) for f in figures], "replay": None,
+        "n_actions": N_MOVES, "n_features": obs_cfg.n_features, **info,
+        "engine": "robocode", "cpu_constant_ms": cpu_constant_ms, "updates": policy.updates,
+        "skipped_turns": sum(res.run.skipped_turns.values()), "bridge_failures": list(res.failures),
+        "bridge_errors": list(res.server_errors), "rtt_mean_us": None if np.isnan(res.rtt_mean_us) else res.rtt_mean_us,
+        "engine_setup_s": res.run.setup_s,
+    }
+    run.write_summary(summary)
+    return summary

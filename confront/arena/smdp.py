@@ -424,20 +424,6 @@ def _pool() -> ThreadPoolExecutor:
     return _POOL[0]
 
 
-_step_range = getattr(K, "step_range", None)
-if _step_range is None:  # arena kernels before step_range: the same per-battle loop over a range
-
-    @njit(cache=True, nogil=True)
-    def _step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score,  # type: ignore
-                    score_total, placements, placements_total, cmd, params, scratch_i, scratch_f):
-        n, k = rf.shape[2], kf.shape[2]
-        for b in range(b0, b1):
-            if not bb[b, K.DONE]:
-                K._step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
-                               placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
-                               scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
-
-
 @njit(cache=True)
 def _relative(a: float) -> float:
     """Angle wrapped to [-pi, pi) (Utils.normalRelativeAngle, as control._rel)."""
@@ -527,8 +513,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                       rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
                       rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem)
         # one Robocode turn of these battles (what Arena.step runs)
-        _step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
-                    placements, placements_total, cmd, params, scratch_i, scratch_f)
+        K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                     placements, placements_total, cmd, params, scratch_i, scratch_f)
         for b in range(b0, b1):
             for i in range(n):
                 if buf[3, b, i] > 0:

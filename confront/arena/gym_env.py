@@ -57,10 +57,11 @@ class AgentDriver:
     """A TeamBattleEnv seen from some agents (robot indices); other learning tanks act by a policy."""
 
     def __init__(self, scenario: Scenario | str, n_battles: int, seed: int, opponents: Any,
-                 config: SMDPConfig, agents: list[int] | None, other_policy: OtherPolicy | None) -> None:
+                 config: SMDPConfig, agents: list[int] | None, other_policy: OtherPolicy | None,
+                 order: str = "engine") -> None:
         sc = get_scenario(scenario) if isinstance(scenario, str) else scenario
         self.env = TeamBattleEnv(sc, n_battles, seed=seed, opponents=opponents,
-                                 config=dataclasses.replace(config, auto_reset=False))
+                                 config=dataclasses.replace(config, auto_reset=False), order=order)
         self.agents = np.asarray([0] if agents is None else agents, dtype=np.int64)
         if not self.env.learner[self.agents].all():
             raise ValueError(f"agents {self.agents.tolist()} must be learning tanks (team 0 or 'td' opponents)")
@@ -112,7 +113,7 @@ class BattleEnv(gym.Env):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         cfg = make_config(turns_per_step, fire_power_actions, config)
         sc = get_scenario(scenario) if isinstance(scenario, str) else scenario
-        self._driver = AgentDriver(sc, 1, seed, opponents, cfg, [0], other_policy)
+        self._driver = AgentDriver(sc, 1, seed, opponents, cfg, [0], other_policy, order)
         self.render_mode = render_mode
         self.render_scale = render_scale
         self.observation_space = make_observation_space(cfg.observation.n_features)

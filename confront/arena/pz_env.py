@@ -41,7 +41,7 @@ class TeamParallelEnv(ParallelEnv):
         sc = get_scenario(scenario) if isinstance(scenario, str) else scenario
         cfg = make_config(turns_per_step, fire_power_actions, config)
         n = sc.teams[0]
-        self._driver = AgentDriver(sc, 1, seed, opponents, cfg, list(range(n)), other_policy)
+        self._driver = AgentDriver(sc, 1, seed, opponents, cfg, list(range(n)), other_policy, order)
         self.possible_agents = [f"tank_{i}" for i in range(n)]
         self.agents: list[str] = []
         self._index = {a: i for i, a in enumerate(self.possible_agents)}

@@ -38,7 +38,7 @@ class BattleVectorEnv(VectorEnv):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         cfg = make_config(turns_per_step, fire_power_actions, config)
-        self._driver = AgentDriver(scenario, num_envs, seed, opponents, cfg, [0], other_policy)
+        self._driver = AgentDriver(scenario, num_envs, seed, opponents, cfg, [0], other_policy, order)
         self.num_envs = num_envs
         self.render_mode = render_mode
         self.single_observation_space = make_observation_space(cfg.observation.n_features)

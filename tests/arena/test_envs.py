@@ -105,3 +105,23 @@ def test_pettingzoo_agents_and_bad_action() -> None:
         env.step({"tank_0": 7})
     with pytest.raises(ValueError, match="unknown agent"):
         env.step({"tank_9": 0})
+
+
+def test_other_policy_drives_td_opponents() -> None:
+    calls = []
+
+    def policy(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        calls.append((disc.shape, feats.shape))
+        return np.full(disc.shape, 1)  # every other learning tank backs off
+
+    v = BattleVectorEnv(3, "1v1", "td", other_policy=policy, seed=1, order="fixed")
+    v.reset(seed=1)
+    team = v._driver.env
+    y0 = team.arena.state.distance_remaining.copy()
+    v.step(np.zeros(3, dtype=np.int64))
+    assert calls == [((3, 2), (3, 2, 7))]
+    assert np.all(y0 == 0)
+    # robot 0 was told "forward" (100 px), robot 1 "backward" (-100 px): the rest of each move remains
+    rem = team.arena.state.distance_remaining
+    assert np.all(rem[:, 0] > 0) and np.all(rem[:, 1] < 0)
+    assert team.arena.order == "fixed"

@@ -17,5 +17,5 @@ fi
 
 PY=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PY" -m venv .venv
-.venv/bin/python -m pip install -q --disable-pip-version-check -e '.[dev,distributed]'
+.venv/bin/python -m pip install -q --disable-pip-version-check -e '.[dev,distributed,baselines]'
 exec .venv/bin/python -m pytest -n 2 --dist loadgroup "$@"

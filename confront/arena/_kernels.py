@@ -73,7 +73,7 @@ HALT_TURNS = 120  # robots halted when endTimer > 4 * TURNS_DISPLAYED_AFTER_ENDI
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     """perm[:n] = 0..n-1, shuffled like Collections.shuffle when mode == 0 (swap(i-1, nextInt(i)))."""
     for i in range(n):
@@ -117,7 +117,7 @@ def _skip_exact(rng: int, n: int) -> int:
     return rng
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def skip_shuffle(rng: int, n: int, mode: int) -> int:
     """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
 
@@ -138,7 +138,7 @@ def skip_shuffle(rng: int, n: int, mode: int) -> int:
     return (_JUMP_A[steps] * rng + _JUMP_C[steps]) & _MASK48
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _reset_inactivity(bi, bf, b, loss):
     """Battle.resetInactiveTurnCount: every 10 energy lost in total restarts the inactivity counter."""
     if loss < 0.0:
@@ -236,7 +236,7 @@ def _remove_from_list(ki, bi, b, pos):
     ki[b, KOWNER, slot] = -1
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params, bb_decided):
     """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
     mode = int(params[P_ORDER])
@@ -360,7 +360,7 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
     ki[b, KSTATE, s] = st
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_body(rf, rb, b, i):
     """RobotPeer.updateHeading: at most min(maxTurnRate, 10 - 0.75|v|) deg; gun and radar follow."""
     rem = rf[b, BODYREM, i]
@@ -386,7 +386,7 @@ def _turn_body(rf, rb, b, i):
         rf[b, H, i] = normal_absolute_angle(rf[b, H, i])
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_gun(rf, rb, b, i):
     """RobotPeer.updateGunHeading: at most 20 deg; the radar follows (adjusted if adjustRadarForGun)."""
     rem = rf[b, GUNREM, i]
@@ -403,7 +403,7 @@ def _turn_gun(rf, rb, b, i):
     rf[b, GH, i] = normal_absolute_angle(rf[b, GH, i])
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_radar(rf, b, i):
     """RobotPeer.updateRadarHeading: at most 45 deg."""
     rem = rf[b, RADREM, i]
@@ -417,7 +417,7 @@ def _turn_radar(rf, b, i):
     rf[b, RH, i] = normal_absolute_angle(rf[b, RH, i])
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _move(rf, rb, b, i):
     """RobotPeer.updateMovement: getNewVelocity, overdrive flag, remaining distance, position, box."""
     d = rf[b, DIST, i]
@@ -480,7 +480,7 @@ def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple
     return True, x, y, ang
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, i, zap, params):
     """RobotPeer.performMove for robot i."""
     n = rf.shape[2]
@@ -568,7 +568,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             rf[b, BODYREM, i] = 0.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
     n = rf.shape[2]

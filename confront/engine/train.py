@@ -5,8 +5,9 @@ One battle of ``train.rounds`` rounds: our side is a team of BridgeBots sharing 
 folder is the simulator's: config.toml, metrics/rounds.csv (same columns), metrics/sessions.csv, model/,
 plots/, summary.json (same keys, plus the engine's skipped turns and bridge failures), and engine/results.txt
 and results.csv (the engine's results for the whole battle). Per-round score parts come from the runner's
-``round_scores`` (each robot's own round score at the round's end).
-No checkpoints: an interrupted engine run starts again from scratch.
+``round_scores`` (each robot's battle totals at each round's end, differenced).
+Curriculum transfer wraps the learner in ``TransferPolicy`` (Eq. 34) as the simulator does. The TD team plays
+its frozen table (``opponent.learning`` is ignored). No checkpoints: an interrupted engine run starts again.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import numpy as np
 
 from confront.arena.observe import ObservationConfig
 from confront.arena.state import SCORE_PARTS
+from confront.checkpoint import CheckpointError
 from confront.config import to_dict
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
 from confront.engine.bridge import Action, Observation
@@ -30,8 +32,17 @@ from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
 from confront.experiments.spec import ExperimentConfig
-from confront.experiments.train import _plots, build_learner, save_model, session_rows, td_team
-from confront.runs import Run
+from confront.experiments.train import (
+    _plots,
+    build_learner,
+    load_model,
+    save_model,
+    session_rows,
+    td_team,
+)
+from confront.learning.base import Learner
+from confront.learning.transfer import TransferParams, TransferPolicy
+from confront.runs import Run, new_run_name
 
 __all__ = ["train_in_engine", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
 
@@ -47,21 +58,30 @@ N_MOVES = 4  # the paper's four macro moves; the engine's robots know no fire-po
 def round_rows(round_scores: list[dict[str, Any]], ours: int = 0) -> list[dict[str, Any]]:
     """Rows of ``metrics/rounds.csv`` (the simulator's columns) from the runner's per-round scores.
 
-    ``ours`` is our contestant index; every other contestant is theirs. A round is decided when at most one
-    contestant has a robot alive at its end.
+    Each entry holds every robot's battle totals at the end of a round; a round's parts are the differences
+    to the previous round's totals, so they add up to the engine's results. ``ours`` is our contestant index;
+    every other contestant is theirs. A round is decided when at most one contestant has a robot alive.
     """
     rows: list[dict[str, Any]] = []
+    before: list[dict[str, float]] | None = None
     for i, rnd in enumerate(round_scores):
         robots = rnd["robots"]
-        mine = [r for r in robots if r["contestant"] == ours]
-        other = [r for r in robots if r["contestant"] != ours]
+        if before is not None and len(before) != len(robots):
+            raise ValueError(f"round {rnd.get('round')} has {len(robots)} robots, the round before {len(before)}")
+        prev = before or [{k: 0.0 for k in ENGINE_PARTS.values()} for _ in robots]
+        # this round's part = battle total now - battle total after the previous round
+        delta = [{k: float(r["score"][k]) - p[k] for k in ENGINE_PARTS.values()}
+                 for r, p in zip(robots, prev, strict=True)]
+        before = [{k: float(r["score"][k]) for k in ENGINE_PARTS.values()} for r in robots]
+        mine = [j for j, r in enumerate(robots) if r["contestant"] == ours]
+        other = [j for j, r in enumerate(robots) if r["contestant"] != ours]
         if not mine or not other:
             raise ValueError(f"round {rnd.get('round')} has no robots of contestant {ours} or no opponents")
-        alive_o = sum(bool(r["alive"]) for r in mine)
-        alive_t = sum(bool(r["alive"]) for r in other)
+        alive_o = sum(bool(robots[j]["alive"]) for j in mine)
+        alive_t = sum(bool(robots[j]["alive"]) for j in other)
         decided = len({r["contestant"] for r in robots if r["alive"]}) <= 1
-        parts_o = {p: sum(float(r["current"][k]) for r in mine) for p, k in ENGINE_PARTS.items()}
-        parts_t = {p: sum(float(r["current"][k]) for r in other) for p, k in ENGINE_PARTS.items()}
+        parts_o = {p: sum(delta[j][k] for j in mine) for p, k in ENGINE_PARTS.items()}
+        parts_t = {p: sum(delta[j][k] for j in other) for p, k in ENGINE_PARTS.items()}
         total_o, total_t = sum(parts_o.values()), sum(parts_t.values())
         row: dict[str, Any] = {"battle": 0, "turns": int(rnd["turns"]), "decided": decided,
                                "score_ours": total_o, "score_theirs": total_t,
@@ -104,8 +124,22 @@ def _check(cfg: ExperimentConfig) -> None:
             robot_class(cfg.opponent.kind)
         except ValueError as exc:
             raise ValueError(f"opponent.kind: {exc}") from None
-    if cfg.transfer.source:
-        raise ValueError("transfer.source is not supported in the engine; train the transfer arm in the simulator")
+
+
+def _transfer(cfg: ExperimentConfig, learner: Learner) -> tuple[Learner, dict[str, Any]]:
+    """Curriculum transfer as in the simulator: the learner wrapped to act from the source with Eq. 34's eps."""
+    tc = cfg.transfer
+    if not tc.source:
+        return learner, {}
+    source, _ = load_model(tc.source)
+    if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
+        raise CheckpointError(
+            f"transfer.source {tc.source} has {source.n_actions} actions on {source.observation} observations; "
+            f"this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
+    if tc.init_from_source:
+        learner.load_state_dict(source.state_dict())
+    wrapped = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
+    return wrapped, {"transfer_source": tc.source}
 
 
 class _Progress:
@@ -135,12 +169,13 @@ def _battle(cfg: ExperimentConfig, opponent: str) -> BattleSpec:
 
 def train_in_engine(
     cfg: ExperimentConfig,
-    out: str | Path,
+    out: str | Path | None,
     progress: bool = True,
     cpu_constant_ms: float = BRIDGE_CPU_CONSTANT_MS,
     exist_ok: bool = False,
 ) -> dict[str, Any]:
-    """Train ``cfg``'s learner for ``train.rounds`` rounds in the real engine into the run folder ``out``.
+    """Train ``cfg``'s learner for ``train.rounds`` rounds in the real engine into the run folder ``out``
+    (default ``runs/<name>-<time>``, as the simulator's ``train_run``).
 
     Returns the summary (train_run's keys plus ``engine``, ``skipped_turns``, ``bridge_failures``,
     ``bridge_errors``, ``updates``, ``rtt_mean_us``, ``cpu_constant_ms``). Bad config values raise ValueError.
@@ -149,8 +184,10 @@ def train_in_engine(
     start = time.time()
     obs_cfg = ObservationConfig(target=cfg.arena.target)
     learner = build_learner(cfg, obs_cfg.n_features, N_MOVES)
-    run = Run.create(Path(out), to_dict(cfg), exist_ok=exist_ok)
-    policy = LearnerPolicy(learner, np.random.default_rng([cfg.train.seed, 0]), train=True, explore=True,
+    acting, transfer_info = _transfer(cfg, learner)
+    run = Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
+                     exist_ok=exist_ok)
+    policy = LearnerPolicy(acting, np.random.default_rng([cfg.train.seed, 0]), train=True, explore=True,
                            observation=obs_cfg, step_turns=cfg.arena.decision_turns)
     # a long training battle gets time: 10 s per round on top of the default limit
     opts = EngineOptions(seed=cfg.train.seed, cpu_constant_ms=cpu_constant_ms)
@@ -181,9 +218,9 @@ def train_in_engine(
         "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
         "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
         "score_ours": sum(r["score_ours"] for r in rows), "score_theirs": sum(r["score_theirs"] for r in rows),
-        "learner": learner.diagnostics(), "wall_time_s": time.time() - start,
+        "learner": acting.diagnostics(), "wall_time_s": time.time() - start,
         "figures": [str(f) for f in figures], "replay": None,
-        "n_actions": N_MOVES, "n_features": obs_cfg.n_features, **info,
+        "n_actions": N_MOVES, "n_features": obs_cfg.n_features, **info, **transfer_info,
         "engine": "robocode", "cpu_constant_ms": cpu_constant_ms, "updates": policy.updates,
         "skipped_turns": sum(res.run.skipped_turns.values()), "bridge_failures": list(res.failures),
         "bridge_errors": list(res.server_errors), "rtt_mean_us": None if np.isnan(res.rtt_mean_us) else res.rtt_mean_us,

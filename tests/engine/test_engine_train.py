@@ -13,26 +13,29 @@ import pytest
 from confront.engine.results import parse_results_text
 from confront.engine.train import ENGINE_PARTS, round_rows, train_in_engine
 from confront.experiments.spec import load_experiment
-from confront.experiments.train import load_model
+from confront.experiments.train import load_model, save_model, td_learner
+from confront.learning.tabular import TabularParams, TabularQ
 
 
 def _robot(contestant: int, alive: bool, **parts: float) -> dict[str, Any]:
-    current = {k: 0.0 for k in ENGINE_PARTS.values()}
-    current.update(parts)
-    current["total"] = sum(v for k, v in current.items() if k != "total")
-    return {"contestant": contestant, "alive": alive, "current": current}
+    score = {k: 0.0 for k in ENGINE_PARTS.values()}
+    score.update(parts)
+    score["total"] = sum(v for k, v in score.items() if k != "total")
+    return {"contestant": contestant, "alive": alive, "score": score}
 
 
 def test_round_rows_by_hand() -> None:
     scores = [
-        # round 1: our two tanks survive, theirs dies: we get 2 x 50 survival + 2 x 10 bonus, 60 + 12 bullets
+        # after round 1: our two tanks survive, theirs dies: 2 x 50 survival + 2 x 10 bonus, 60 + 12 bullets
         {"round": 0, "turns": 700, "robots": [
             _robot(0, True, survival=50.0, surv_bonus=10.0, bullet_dmg=60.0, bullet_bonus=12.0),
             _robot(0, True, survival=50.0, surv_bonus=10.0, ram_dmg=2.4),
             _robot(1, False, bullet_dmg=30.0)]},
-        # round 2: both sides still have a robot alive (undecided), nobody wins
+        # after round 2 (battle totals): both sides still have a robot alive (undecided); bullets 4 and 16
         {"round": 1, "turns": 900, "robots": [
-            _robot(0, True, bullet_dmg=4.0), _robot(0, False), _robot(1, True, bullet_dmg=16.0)]},
+            _robot(0, True, survival=50.0, surv_bonus=10.0, bullet_dmg=64.0, bullet_bonus=12.0),
+            _robot(0, False, survival=50.0, surv_bonus=10.0, ram_dmg=2.4),
+            _robot(1, True, bullet_dmg=46.0)]},
     ]
     r1, r2 = round_rows(scores)
     assert r1["round"] == 1 and r2["round"] == 2 and r1["turns"] == 700
@@ -44,20 +47,24 @@ def test_round_rows_by_hand() -> None:
     assert r1["bullet_kill_bonus_ours"] == 12.0 and r1["ram_damage_ours"] == pytest.approx(2.4)
     assert r1["decided"] and r1["won"] and (r1["alive_ours"], r1["alive_theirs"]) == (2, 0)
     assert not r2["decided"] and not r2["won"] and (r2["alive_ours"], r2["alive_theirs"]) == (1, 1)
-    assert r2["score_ratio"] == pytest.approx(0.2)
+    assert (r2["score_ours"], r2["score_theirs"]) == pytest.approx((4.0, 16.0))
+    assert r2["score_ratio"] == pytest.approx(0.2) and r2["defensive_ours"] == 0.0
     with pytest.raises(ValueError, match="contestant 3"):
         round_rows(scores, ours=3)
+    with pytest.raises(ValueError, match="2 robots, the round before 3"):
+        round_rows([scores[0], {**scores[1], "robots": scores[1]["robots"][:2]}])
 
 
-@pytest.mark.parametrize(("override", "match"), [
-    ("arena.scenario=big.toml", "arena.scenario"),
-    ("arena.fire_power_actions=true", "fire_power_actions"),
-    ("opponent.kind=NoSuchBot", "opponent.kind"),
-    ("transfer.source=runs/x", "transfer.source"),
+@pytest.mark.parametrize(("override", "error", "match"), [
+    ("arena.scenario=big.toml", ValueError, "arena.scenario"),
+    ("arena.fire_power_actions=true", ValueError, "fire_power_actions"),
+    ("opponent.kind=NoSuchBot", ValueError, "opponent.kind"),
+    ("transfer.source=no/such/run", FileNotFoundError, "no trained model"),
 ])
-def test_bad_config_is_refused_before_anything_runs(tmp_path: Path, override: str, match: str) -> None:
+def test_bad_config_is_refused_before_anything_runs(tmp_path: Path, override: str, error: type[Exception],
+                                                    match: str) -> None:
     cfg = load_experiment("demo", ["train.rounds=2", "train.session_rounds=1", override])
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises(error, match=match):
         train_in_engine(cfg, tmp_path / "run", progress=False)
     assert not (tmp_path / "run").exists()
 
@@ -90,3 +97,37 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path) -> 
     assert info["engine"] == "robocode" and learner.step == summary["updates"]
     assert np.ptp(learner.state_dict()["q"]) > 0  # the saved Q table moved away from its constant start
     assert (out / "config.toml").exists() and (out / "metrics" / "sessions.csv").exists()
+
+
+@pytest.mark.engine
+def test_team_trains_against_exported_td_team_with_transfer(install, tmp_path: Path) -> None:
+    base = load_experiment("demo", ["arena.scenario=4v4", "learner.kind=ssaq", "train.rounds=1",
+                                    "train.session_rounds=1", "arena.decision_turns=10"])
+    td = td_learner(base, 4)
+    td.q[:] = np.random.default_rng(5).normal(size=td.q.shape)
+    save_model(tmp_path / "td", td, {})
+    src = TabularQ(TabularParams(n_states=320, n_actions=4))
+    src.q[:] = 0.0
+    src.q[:, 2] = 1.0  # the source always turns right while moving
+    save_model(tmp_path / "src" / "model", src, {})
+    cfg = load_experiment("demo", ["arena.scenario=4v4", "learner.kind=ssaq", "train.rounds=1",
+                                   "train.session_rounds=1", "arena.decision_turns=10", "opponent.kind=td",
+                                   f"opponent.model={tmp_path / 'td'}", f"transfer.source={tmp_path / 'src'}",
+                                   "transfer.epsilon0=1.0", "transfer.floor=1.0", "transfer.init_from_source=false"])
+    summary = train_in_engine(cfg, tmp_path / "run", progress=False)
+    with open(tmp_path / "run" / "metrics" / "rounds.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert int(row["alive_ours"]) <= 4 and int(row["alive_theirs"]) <= 4
+    assert int(row["alive_ours"]) + int(row["alive_theirs"]) >= 1
+    res = parse_results_text((tmp_path / "run" / "engine" / "results.txt").read_text())
+    for side, name in (("ours", "Ours"), ("theirs", "Them")):
+        team = next(c for c in res.contestants if name in c.name)
+        assert float(row[f"score_{side}"]) == pytest.approx(team.total, abs=0.5)
+    assert summary["td_model"] == str(tmp_path / "td") and summary["transfer_source"] == str(tmp_path / "src")
+    assert summary["decisions"] > 4 * 10 and summary["updates"] >= summary["decisions"] - 4
+    assert summary["bridge_failures"] == [] and summary["bridge_errors"] == []
+    # eps = 1: the four tanks only ever took the source's move 2, so only that column of the saved table learned
+    learner, _ = load_model(tmp_path / "run")
+    q0 = TabularQ(TabularParams(n_states=320, n_actions=4)).q
+    changed = (learner.q != q0).any(axis=0)
+    assert changed.tolist() == [False, False, True, False]

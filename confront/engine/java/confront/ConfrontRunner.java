@@ -219,7 +219,11 @@ public final class ConfrontRunner extends BattleAdaptor {
         }
     }
 
-    /** Per robot the round's own score parts (exact doubles) and whether it is alive at the round's end. */
+    /**
+     * Per robot its battle totals so far (exact doubles) and whether it is alive, at the round's end. Per-round
+     * parts are differences of these: a robot's "current" round score can grow after its death (its bullets
+     * still in flight) while its totals, which the results file adds up, were closed at its death.
+     */
     private void roundScore(int round, int turns, ITurnSnapshot snap) {
         if (roundScores.length() > 0) {
             roundScores.append(',');
@@ -233,8 +237,8 @@ public final class ConfrontRunner extends BattleAdaptor {
             }
             roundScores.append("{\"contestant\":").append(rs[i].getContestantIndex())
                     .append(",\"alive\":").append(rs[i].getState() != robocode.control.snapshot.RobotState.DEAD)
-                    .append(",\"current\":");
-            current(roundScores, rs[i].getScoreSnapshot());
+                    .append(",\"score\":");
+            score(roundScores, rs[i].getScoreSnapshot());
             roundScores.append('}');
         }
         roundScores.append("]}");

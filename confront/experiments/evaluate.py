@@ -188,25 +188,21 @@ def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | N
     if replay is None:
         return None
     out_dir.mkdir(parents=True, exist_ok=True)
-    path = replay.save(out_dir / "last_round.json")
+    path = replay.save(out_dir / "last_round.replay.json.gz")
     rp.write_gif(replay, out_dir / "last_round.gif")
     rp.write_html(replay, out_dir / "last_round.html", title=f"confront: {cfg.name}")
     return str(path)
 
 
 def replay_cli(source: Path, out: Path | None) -> None:
-    from confront.arena import replay as rp
+    from confront.arena.replay import export_replays
 
-    files = sorted(source.glob("replays/*.json")) + sorted(source.glob("*.json")) if source.is_dir() else [source]
-    files = [f for f in files if f.name != "summary.json"]
-    if not files:
-        raise FileNotFoundError(f"no replay files in {source}")
-    for f in files:
-        replay = rp.load_replay(f)
-        stem = out if (out is not None and len(files) == 1) else f.with_suffix("")
-        gif = rp.write_gif(replay, Path(f"{stem}.gif"))
-        page = rp.write_html(replay, Path(f"{stem}.html"))
-        click.echo(f"{f}: {len(replay)} frames -> {gif}, {page}")
+    try:
+        written = export_replays(source, out)
+    except ValueError as exc:
+        raise FileNotFoundError(str(exc)) from None
+    for path in written:
+        click.echo(f"wrote {path}")
 
 
 BENCHES = {"sim": "sim_throughput.py", "learner": "learner_throughput.py", "env": "env_throughput.py",

@@ -57,6 +57,10 @@ class LearnerSection:
     awm: bool = field(True, doc="adaptive momentum (Eq. 23-24) on; off = plain back-propagation")
     nn_rate: float = field(0.9, gt=0.0, le=1.0, doc="NN learning rate without AWM (Table 2: 0.9)")
     momentum: float = field(0.95, ge=0.0, lt=1.0, doc="momentum constant beta (Table 2: 0.95)")
+    output: Literal["linear", "bipolar"] = field("linear", doc="DMNN output layer: linear, or Eq. 20's bipolar")
+    q_scale: float = field(10.0, gt=0.0, doc="DMNN network units: Q = q_scale * output (not in the paper)")
+    td_clip: float = field(5.0, ge=0.0, doc="clip of the TD error in network units, 0 = off (not in the paper; "
+                           "without it AWM diverges on Eq. 35's heavy-tailed rewards)")
 
 
 @dataclass
@@ -65,7 +69,7 @@ class TransferSection:
 
     source: str = field("", doc="run folder of the source task; empty = learn from scratch")
     epsilon0: float = field(0.9, ge=0.0, le=1.0, doc="eps(t0): initial probability of acting from the source")
-    decay: float = field(0.01, ge=0.0, doc="p in eps(t) = eps(t0) exp(-p (t - t0)), t in rounds")
+    decay: float = field(0.002, ge=0.0, doc="p in eps(t) = eps(t0) exp(-p (t - t0)), t in SMDP steps (learn calls)")
     floor: float = field(0.05, ge=0.0, le=1.0, doc="stable value eps(t) decays to")
     init_from_source: bool = field(True, doc="start the learner from the source model's weights (Eq. 33)")
 

@@ -32,11 +32,12 @@ from confront.arena.state import SCORE_PARTS
 from confront.config import load_toml, to_dict
 from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.learning.base import Learner, Transition
-from confront.learning.dmnn import DMNN, DMNNParams
-from confront.learning.tabular import TabularParams, TabularQ
+from confront.learning.factory import load_learner, make_learner, save_learner
+from confront.learning.tabular import TabularQ
+from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
-__all__ = ["train_run", "print_summary", "build_learner", "load_model", "scenario_of", "td_team"]
+__all__ = ["train_run", "print_summary", "build_learner", "load_model", "save_model", "scenario_of", "td_team"]
 
 
 # -- building blocks ---------------------------------------------------------------------------------------------
@@ -59,17 +60,17 @@ def build_learner(cfg: ExperimentConfig, n_features: int, n_actions: int) -> Lea
     common = dict(n_actions=n_actions, gamma=lc.gamma, alpha=lc.alpha, rate=lc.learning_rate, backup=lc.backup,
                   exploration="boltzmann", t_max=lc.t_max, t_min=lc.t_min, eta=lc.eta)
     if lc.kind == "ssaq":
-        return TabularQ(TabularParams(n_states=320, **common), kind="ssaq")
-    return DMNN(DMNNParams(n_inputs=n_features, observation="features", hidden=lc.hidden, awm=lc.awm,
-                           momentum=lc.momentum, nn_rate=lc.nn_rate, init_seed=cfg.train.seed, **common))
+        return make_learner("ssaq", n_states=320, **common)
+    return make_learner("dmnn", n_inputs=n_features, observation="features", hidden=lc.hidden, awm=lc.awm,
+                        momentum=lc.momentum, nn_rate=lc.nn_rate, output=lc.output, q_scale=lc.q_scale,
+                        td_clip=lc.td_clip, init_seed=cfg.train.seed, **common)
 
 
-def td_learner(cfg: ExperimentConfig, n_actions: int) -> TabularQ:
+def td_learner(cfg: ExperimentConfig, n_actions: int) -> Learner:
     """The TD team's learner: tabular one-step Q-learning, epsilon-greedy, fixed rate (paper §6.3)."""
     oc = cfg.opponent
-    return TabularQ(TabularParams(n_states=320, n_actions=n_actions, gamma=oc.gamma, alpha=oc.alpha, rate="fixed",
-                                  backup="smdp", bootstrap="max", exploration="egreedy", exploit=oc.exploit),
-                    kind="td")
+    return make_learner("qlearning_egreedy", n_states=320, n_actions=n_actions, gamma=oc.gamma, alpha=oc.alpha,
+                        exploit=oc.exploit)
 
 
 def _obs(learner: Learner, disc: np.ndarray, feats: np.ndarray) -> np.ndarray:
@@ -77,20 +78,18 @@ def _obs(learner: Learner, disc: np.ndarray, feats: np.ndarray) -> np.ndarray:
 
 
 def save_model(folder: Path, learner: Learner, meta: dict[str, Any]) -> None:
-    """``model.npz`` (learner state) + ``model.json`` (kind, parameters, observation), atomically."""
+    """``learner.npz`` (kind, parameters and state; no pickle) + ``model.json`` (the task it was trained on)."""
     folder.mkdir(parents=True, exist_ok=True)
-    import io
-
-    buf = io.BytesIO()
-    np.savez(buf, **learner.state_dict())
-    ck.write_atomic(folder / "model.npz", buf.getvalue())
+    tmp = folder / ".learner.npz.tmp"
+    save_learner(tmp, learner.current if isinstance(learner, TransferPolicy) else learner)
+    os.replace(tmp, folder / "learner.npz")
     info = {"format": "confront-model/1", "kind": learner.kind, "observation": learner.observation,
-            "n_actions": learner.n_actions, "params": learner.params.to_dict(), **meta}
+            "n_actions": learner.n_actions, **meta}
     ck.write_atomic(folder / "model.json", json.dumps(info, indent=1, sort_keys=True).encode())
 
 
 def load_model(folder: str | Path) -> tuple[Learner, dict[str, Any]]:
-    """Load a learner written by :func:`save_model` (a run folder's ``model/`` or the run folder itself)."""
+    """Load a learner written by :func:`save_model` (a run folder, its ``model/``, or a model folder)."""
     p = Path(folder)
     if (p / "model").is_dir():
         p = p / "model"
@@ -102,15 +101,9 @@ def load_model(folder: str | Path) -> tuple[Learner, dict[str, Any]]:
         raise ck.CheckpointError(f"model {p} has a corrupt model.json ({exc})") from None
     if info.get("format") != "confront-model/1":
         raise ck.CheckpointError(f"{p} is not a confront model (format {info.get('format')!r})")
-    params = {k: tuple(v) if isinstance(v, list) else v for k, v in info["params"].items()}
-    if info["kind"] == "dmnn":
-        learner: Learner = DMNN(DMNNParams(**params))
-    else:
-        learner = TabularQ(TabularParams(**params), kind=info["kind"])
     try:
-        with np.load(p / "model.npz", allow_pickle=False) as data:
-            learner.load_state_dict({k: data[k] for k in data.files})
-    except (OSError, ValueError) as exc:
+        learner = load_learner(p / "learner.npz", frozen=False)
+    except (OSError, ValueError, KeyError) as exc:
         raise ck.CheckpointError(f"model {p} cannot be read: {exc}") from None
     return learner, info
 
@@ -126,12 +119,6 @@ class Side:
     opponent: Learner | None = None
     theirs: np.ndarray | None = None  # (R,) bool, robots the opponent learner drives
     opponent_learns: bool = False
-    source: Learner | None = None  # curriculum transfer: the source task's policy (Eq. 34)
-
-
-def transfer_epsilon(rounds_done: int, epsilon0: float, decay: float, floor: float) -> float:
-    """Probability of acting from the source policy after ``rounds_done`` rounds."""
-    return max(floor, epsilon0 * float(np.exp(-decay * rounds_done)))  # Eq. 34, t0 = 0, floored at the stable value
 
 
 def _round_row(end: Any, b: int, team: np.ndarray) -> dict[str, Any]:
@@ -153,13 +140,11 @@ def _round_row(end: Any, b: int, team: np.ndarray) -> dict[str, Any]:
 class Loop:
     """The SMDP interaction loop over a TeamBattleEnv; state is data so it can be checkpointed."""
 
-    def __init__(self, env: TeamBattleEnv, side: Side, seed: int, transfer: tuple[float, float, float] | None = None,
-                 learning: bool = True) -> None:
+    def __init__(self, env: TeamBattleEnv, side: Side, seed: int, learning: bool = True) -> None:
         self.env, self.side = env, side
         self.learning = learning  # False: evaluate greedily, nothing learns
         self.team = env.team_ids()
-        self.rngs = {name: np.random.default_rng([seed, i]) for i, name in enumerate(("act", "opp", "tf"))}
-        self.transfer = transfer
+        self.rngs = {name: np.random.default_rng([seed, i]) for i, name in enumerate(("act", "opp"))}
         self.rounds_done = 0
         self.decisions = 0
         self.rows: list[dict[str, Any]] = []
@@ -200,15 +185,7 @@ class Loop:
         actions = np.zeros((b, r), dtype=np.int64)
         obs_ours = _obs(side.learner, self.disc, self.feats)[:, side.ours]
         flat = obs_ours.reshape((-1,) + obs_ours.shape[2:])
-        ours_a = side.learner.act(flat, self.rngs["act"], explore=self.learning).reshape(b, -1)
-        if side.source is not None and self.transfer is not None:
-            eps = transfer_epsilon(self.rounds_done, *self.transfer)
-            use_source = self.rngs["tf"].random(ours_a.shape) < eps
-            src_obs = _obs(side.source, self.disc, self.feats)[:, side.ours]
-            src_a = side.source.act(src_obs.reshape((-1,) + src_obs.shape[2:]), self.rngs["tf"],
-                                    explore=False).reshape(b, -1)
-            ours_a = np.where(use_source, src_a, ours_a)
-        actions[:, side.ours] = ours_a
+        actions[:, side.ours] = side.learner.act(flat, self.rngs["act"], explore=self.learning).reshape(b, -1)
         if side.opponent is not None and side.theirs is not None:
             obs_t = _obs(side.opponent, self.disc, self.feats)[:, side.theirs]
             their_a = side.opponent.act(obs_t.reshape((-1,) + obs_t.shape[2:]), self.rngs["opp"],
@@ -248,7 +225,7 @@ class Loop:
             self.last_learn = out
 
 
-def td_team(cfg: ExperimentConfig, n_actions: int, progress: bool = False) -> tuple[TabularQ, Path]:
+def td_team(cfg: ExperimentConfig, n_actions: int, progress: bool = False) -> tuple[Learner, Path]:
     """The opponent TD team: loaded from ``opponent.model`` or trained once and cached as a reusable artefact.
 
     Pre-training: the TD learner drives a 4-tank team against the scripted ``opponent.pretrain_against``
@@ -346,19 +323,18 @@ def _setup(cfg: ExperimentConfig, progress: bool) -> tuple[Loop, dict[str, Any]]
         td, where = td_team(cfg, env.n_actions, progress=progress)
         side.opponent, side.theirs, side.opponent_learns = td, team != 0, cfg.opponent.learning
         info["td_model"] = str(where)
-    transfer = None
     if cfg.transfer.source:
-        source, src_info = load_model(cfg.transfer.source)
-        if source.n_actions != learner.n_actions or source.observation != learner.observation:
+        source, _ = load_model(cfg.transfer.source)
+        if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
             raise ck.CheckpointError(
                 f"transfer.source {cfg.transfer.source} has {source.n_actions} actions on {source.observation} "
                 f"observations; this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
         if cfg.transfer.init_from_source:
             learner.load_state_dict(source.state_dict())
-        side.source = source
-        transfer = (cfg.transfer.epsilon0, cfg.transfer.decay, cfg.transfer.floor)
+        tc = cfg.transfer
+        side.learner = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
         info["transfer_source"] = cfg.transfer.source
-    return Loop(env, side, seed=cfg.train.seed, transfer=transfer), info
+    return Loop(env, side, seed=cfg.train.seed), info
 
 
 def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool = False, progress: bool = True,

@@ -59,7 +59,7 @@ def test_run_folder_layout(reference: tuple[Path, Path]) -> None:
     assert float(first["score_ours"]) == pytest.approx(sum(float(r["score_ours"]) for r in chunk))
     summary = json.loads((run / "summary.json").read_text())
     assert summary["rounds"] == 48 and 0.0 <= summary["final_score_ratio"] <= 1.0
-    assert (run / "model" / "model.npz").exists() and (run / "model" / "model.json").exists()
+    assert (run / "model" / "learner.npz").exists() and (run / "model" / "model.json").exists()
 
 
 def test_same_seed_same_metrics_other_seed_differs(reference: tuple[Path, Path], tmp_path: Path) -> None:

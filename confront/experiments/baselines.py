@@ -12,6 +12,11 @@ Trained methods learn against the TD team (the paper's opponent, ``train.td_team
 for the same number of rounds; then every method plays ``eval_rounds`` greedy rounds against each opponent
 (the TD team, acting greedily, and scripted SpinBot) on the same battle seeds. Per seed the score ratio is
 pooled over those rounds; methods are ranked by the mean over seeds with a 95% bootstrap interval.
+
+Output, ``<out>/baselines/``: ``runs/dmnn-flm/seed-k`` (ordinary run folders), ``eval/<method>/seed-k/
+result.json`` (that method's evaluation rows; SB3 methods also ``policy.npz``, the network's parameters),
+``results.csv`` (one row per method, seed and opponent), ``ranking.md``, ``figures/ranking.png``,
+``config.json``. Finished (method, seed) pairs are not re-run.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
-from confront.experiments.reproduce import Job, Outcome, run_jobs
+from confront.experiments.reproduce import Job, Outcome, _slug, run_jobs
 from confront.experiments.stats import Interval, interval
 from confront.learning.base import Learner, Transition
 
@@ -451,7 +456,7 @@ def baselines_outcome(n_seeds: int, out: Path, rounds: int | None, workers: int,
     start = time.time()
     # 1. the paper's method, as the paper's arms are trained (this also builds each seed's TD team)
     dmnn = [Job("baselines", DMNN_METHOD, s, cfg.base, cfg.overrides + ("learner.learning_rate=\"fuzzy\"",),
-                runs / "dmnn-flm" / f"seed-{s}") for s in range(n_seeds)]
+                runs / _slug(DMNN_METHOD) / f"seed-{s}") for s in range(n_seeds)]
     run_jobs(dmnn, rounds, workers)
     # 2. SB3 methods (trained here) and scripted robots, evaluated on the same seeds
     skipped: dict[str, str] = {}
@@ -464,10 +469,7 @@ def baselines_outcome(n_seeds: int, out: Path, rounds: int | None, workers: int,
     methods += list(cfg.scripted)
     tasks = [(m, s) for m in methods for s in range(n_seeds)]
 
-    def folder(m: str) -> Path:
-        return runs / "".join(c if c.isalnum() else "-" for c in m.lower()).strip("-")
-
-    args = [(m, cfg, s, rounds, folder(m) / f"seed-{s}", dmnn[s].folder) for m, s in tasks]
+    args = [(m, cfg, s, rounds, root / "eval" / _slug(m) / f"seed-{s}", dmnn[s].folder) for m, s in tasks]
     if workers <= 1:
         results = [_method_job(*a) for a in args]
     else:

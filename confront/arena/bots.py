@@ -50,6 +50,7 @@ M_VAR = 8  # 8 bot variables
 M_SAVE = 16  # stop(): saved distance, body, gun, radar remaining
 M_TARGET = 20  # scanned target of the running handler (fire assist)
 M_FRESH = 21  # 1 while the handler started in this decision (fire assist needs the scan's own turn)
+M_STOPPED = 22  # movement saved by stop() and not yet resumed
 M_HOPS = 24
 M_MOPS = M_HOPS + 2 * Q
 M_STATIC = M_MOPS + 2 * Q  # kept across rounds (Corners' corner)
@@ -247,14 +248,19 @@ def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, 
     if op == O_SCAN:
         scan_req[b, i] = True
         return True
-    if op == O_STOP:
+    if op == O_STOP:  # stop(): saves the movement unless some is saved already, then halts
+        if mem[b, i, M_STOPPED] == 0.0:
+            for k in range(4):
+                mem[b, i, M_SAVE + k] = rem[k]
+            mem[b, i, M_STOPPED] = 1.0
         for k in range(4):
-            mem[b, i, M_SAVE + k] = rem[k]
             cmd[b, i, k] = 0.0
         return True
     if op == O_RESUME:
-        for k in range(4):
-            cmd[b, i, k] = mem[b, i, M_SAVE + k]
+        if mem[b, i, M_STOPPED] == 1.0:
+            for k in range(4):
+                cmd[b, i, k] = mem[b, i, M_SAVE + k]
+            mem[b, i, M_STOPPED] = 0.0
         return True
     if op == O_SETMAXV:
         if val >= 0.0:

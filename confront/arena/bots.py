@@ -418,6 +418,30 @@ def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_w
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
+def _finish_handler(mem, b, i, rem):
+    """A handler whose last operation just finished returns before this turn's events are dispatched.
+
+    Events that could not interrupt it (same or lower priority) are then handled at once, as
+    Robocode's EventManager does when the handler returns. A handler waiting in scan() is left to
+    _events, which restarts it when a robot is seen (Robocode's rescan).
+    """
+    if mem[b, i, M_HPRIO] == 0 or mem[b, i, M_HSTART] != 1:
+        return
+    pos = int(mem[b, i, M_HPOS])
+    n = int(mem[b, i, M_HLEN])
+    if pos >= n or pos != n - 1:
+        return
+    op = mem[b, i, M_HOPS + 2 * pos]
+    if op == O_SCAN:
+        return
+    if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
+        mem[b, i, M_HLEN] = 0
+        mem[b, i, M_HPOS] = 0
+        mem[b, i, M_HPRIO] = 0
+        mem[b, i, M_HSTART] = 0
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
               ev_hitby_bearing, ev_died, width, height, cmd, rem):
@@ -440,12 +464,13 @@ def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_r
                 continue
             if energy[b, i] == 0.0:
                 continue
-            _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot,
-                    ev_robot_bearing, ev_fault, ev_hitby, ev_hitby_bearing, cmd)
             rem[0] = dist_rem[b, i]
             rem[1] = body_rem[b, i]
             rem[2] = gun_rem[b, i]
             rem[3] = radar_rem[b, i]
+            _finish_handler(mem, b, i, rem)
+            _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot,
+                    ev_robot_bearing, ev_fault, ev_hitby, ev_hitby_bearing, cmd)
             t = int(mem[b, i, M_TARGET])
             tx = x[b, t] if t >= 0 else 0.0
             ty = y[b, t] if t >= 0 else 0.0

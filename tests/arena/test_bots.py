@@ -154,3 +154,34 @@ def test_bots_state_dict_round_trip():
         bots2.commands(cmd2)
         b.step(cmd2)
         np.testing.assert_array_equal(b.state.x, x)
+
+
+# Recorded from the real engine (Robocode 1.9.3.9): sample.SpinBot vs sample.Walls, -DRANDOMSEED=5,
+# CPU constant 10 ms, no skipped turns; round 1 lasted 1265 turns (150 after the decision). Per turn:
+# (x, y, energy) of SpinBot and Walls. The simulator with seed 5 draws the same start positions and,
+# with the scripted bots, plays the same round.
+ENGINE_SPINBOT_WALLS = {
+    50: ((563.065866142257, 127.74815304335698, 100.0), (372.2174922459349, 18.0, 100.0)),
+    200: ((480.6401849450951, 100.37772280900053, 91.0), (18.0, 582.0, 96.0)),
+    400: ((571.7130874513518, 107.73625104496173, 62.0), (754.0, 18.0, 100.0)),
+    600: ((483.3015819923518, 84.67487183237904, 33.0), (102.0, 582.0, 104.0)),
+    800: ((566.3653515491083, 122.73839368382762, 14.0), (642.0, 18.0, 104.0)),
+    1000: ((491.1731685002858, 70.82927004389498, 4.0), (206.0, 582.0, 86.0)),
+    1100: ((487.4517354741597, 124.12360351290145, 0.0), (782.0, 466.0, 82.0)),
+    1265: ((487.4517354741597, 124.12360351290145, 0.0), (18.0, 18.0, 88.0)),
+}
+
+
+def test_spinbot_vs_walls_replays_an_engine_round():
+    sc = get_scenario("melee").replace(teams=(1, 1), turns_after_end=150, max_turns=100000)
+    arena = Arena(sc, 1, seed=5)
+    bots = ScriptedBots(arena, ["SpinBot", "Walls"])
+    cmd = arena.idle_commands()
+    s = arena.state
+    for t in range(1, 1266):
+        bots.commands(cmd)
+        arena.step(cmd)
+        if t in ENGINE_SPINBOT_WALLS:
+            got = np.stack([s.x[0], s.y[0], s.energy[0]], 1)
+            np.testing.assert_allclose(got, ENGINE_SPINBOT_WALLS[t], atol=1e-6, err_msg=f"turn {t}")
+    assert s.done[0] and s.time[0] == 1265

@@ -197,6 +197,7 @@ def train_in_engine(
         wrapped = _Progress(policy, cfg.train.rounds, f"{cfg.name} {cfg.arena.scenario} (robocode)", progress)
         try:
             res: BridgedRun = run_bridged_battle(_battle(cfg, opponent), wrapped, opts, extra_robots=extra)
+            wrapped.bar.update(cfg.train.rounds - wrapped.bar.n)  # the last round has ended too
         finally:
             wrapped.bar.close()
     rows = round_rows(res.run.summary["round_scores"])

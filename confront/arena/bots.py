@@ -31,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .core import Arena
+from .core import Arena, _pool
 from .rules import normal_absolute_angle, normal_relative_angle
 
 __all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind", "bot_battle"]
@@ -441,7 +441,7 @@ def _finish_handler(mem, b, i, rem):
         mem[b, i, M_HSTART] = 0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
               ev_hitby_bearing, ev_died, width, height, cmd, rem):
@@ -515,7 +515,7 @@ class ScriptedBots:
         self.names = list(names)
         self.kinds = np.array([bot_kind(n) for n in names], dtype=np.int64)
         self.mem = np.zeros((arena.n_battles, arena.n_robots, M_SIZE))
-        self._rem = np.zeros(4)
+        self._rem = np.zeros((8, 4))
         self._apply_flags()
         self._round = arena.state.round.copy()
         self.reset()
@@ -562,13 +562,28 @@ class ScriptedBots:
         bots = self.kinds != K_NONE
         cmd[:, bots, :4] = np.nan
         cmd[:, bots, 4] = 0.0
-        bots_step(self.kinds, self.mem, s.x, s.y, s.heading, s.gun_heading, s.radar_heading, s.energy, s.alive,
-                  s.team, s.distance_remaining, s.body_turn_remaining, s.gun_turn_remaining,
-                  s.radar_turn_remaining, s.max_velocity, s.fire_assist, s.scan_request, s.scanned, s.ev_hit_wall,
-                  s.ev_hit_robot, s.ev_hit_robot_bearing, s.ev_at_fault, s.ev_hit_by_bullet,
-                  s.ev_hit_by_bullet_bearing, s.ev_died, float(self.arena.scenario.width),
-                  float(self.arena.scenario.height), cmd, self._rem)
+        nb, workers = self.arena.n_battles, self.arena.threads
+        if nb >= 64 and workers > 1:
+            size = -(-nb // workers)
+            futures = [_pool(workers).submit(self._run, slice(lo, min(nb, lo + size)), cmd, k)
+                       for k, lo in enumerate(range(0, nb, size))]
+            for f in futures:
+                f.result()
+        else:
+            self._run(slice(None), cmd, 0)
         return cmd
+
+    def _run(self, r: slice, cmd: np.ndarray, k: int) -> None:
+        """bots_step on the battles of slice r (k: which scratch row)."""
+        s = self.arena.state
+        if k >= len(self._rem):
+            self._rem = np.zeros((k + 1, 4))
+        bots_step(self.kinds, self.mem[r], s.x[r], s.y[r], s.heading[r], s.gun_heading[r], s.radar_heading[r],
+                  s.energy[r], s.alive[r], s.team[r], s.distance_remaining[r], s.body_turn_remaining[r],
+                  s.gun_turn_remaining[r], s.radar_turn_remaining[r], s.max_velocity[r], s.fire_assist[r],
+                  s.scan_request[r], s.scanned[r], s.ev_hit_wall[r], s.ev_hit_robot[r], s.ev_hit_robot_bearing[r],
+                  s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r], s.ev_died[r],
+                  float(self.arena.scenario.width), float(self.arena.scenario.height), cmd[r], self._rem[k])
 
 
 def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20,

@@ -59,8 +59,8 @@ class LearnerSection:
     momentum: float = field(0.95, ge=0.0, lt=1.0, doc="momentum constant beta (Table 2: 0.95)")
     output: Literal["linear", "bipolar"] = field("linear", doc="DMNN output layer: linear, or Eq. 20's bipolar")
     q_scale: float = field(10.0, gt=0.0, doc="DMNN network units: Q = q_scale * output (not in the paper)")
-    td_clip: float = field(5.0, ge=0.0, doc="clip of the TD error in network units, 0 = off (not in the paper; "
-                           "without it AWM diverges on Eq. 35's heavy-tailed rewards)")
+    td_clip: float = field(1.0, ge=0.0, doc="clip of the TD error in network units, 0 = off (not in the paper; "
+                           "measured: at 5 the fuzzy AWM network diverged on Eq. 35's heavy-tailed rewards)")
 
 
 @dataclass

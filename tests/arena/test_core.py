@@ -220,3 +220,47 @@ def test_random_start_positions_follow_java_random():
     # first robot: x = 36 + nextDouble * (800 - 72) with new Random(42)
     assert a.state.x[0, 0] == pytest.approx(36 + 0.7275636800328681 * 728)
     assert (a.state.x >= 36).all() and (a.state.x <= 764).all()
+
+
+def test_builtin_scenarios():
+    from confront.arena.scenarios import scenario_names
+
+    assert {"1v1", "4v4", "4v6", "4v10", "melee"} <= set(scenario_names())
+    sc = get_scenario("4v10")
+    assert sc.teams == (4, 10) and sc.n_robots == 14 and sc.width == 800 and sc.height == 600
+    assert sc.team_ids()[:5] == [0, 0, 0, 0, 1]
+    with pytest.raises(ValueError, match="unknown scenario"):
+        get_scenario("9v9")
+
+
+def test_user_scenario_from_toml(tmp_path):
+    from confront.arena.scenarios import load_scenario
+
+    p = tmp_path / "duel.toml"
+    p.write_text('name = "wide"\nteams = [2, 3]\nwidth = 1000\nheight = 1000\nopponents = "Walls"\n')
+    sc = load_scenario(p)
+    assert (sc.name, sc.teams, sc.width, sc.opponents) == ("wide", (2, 3), 1000.0, "Walls")
+    a = Arena(sc, 2, seed=3)
+    assert a.state.is_leader[0].tolist() == [True, False, True, False, False]
+    assert a.state.energy[0].tolist() == [200.0, 100.0, 200.0, 100.0, 100.0]
+    p.write_text('name = "bad"\nteams = [1, 1]\nwidht = 900\n')
+    with pytest.raises(ValueError, match="widht"):
+        load_scenario(p)
+    p.write_text('name = "bad"\nteams = [1, 1]\ngun_cooling_rate = 2.0\n')
+    with pytest.raises(ValueError, match="gun_cooling_rate"):
+        load_scenario(p)
+
+
+def test_team_fire_damages_but_scores_nothing():
+    sc = get_scenario("4v4").replace(teams=(2, 1), initial_positions=((100, 300, 90), (300, 300, 0),
+                                                                      (700, 500, 0)))
+    a = Arena(sc, 1, order="fixed")
+    cmd = a.idle_commands()
+    cmd[0, 0, 4] = 3.0
+    for _ in range(60):
+        a.step(cmd)
+        cmd[0, 0, 4] = 0.0 if a.state.ev_fired[0, 0] else cmd[0, 0, 4]
+    # the team-mate at x=300 took 16 (leader has 200), the shooter got 9 back, no score
+    assert a.state.energy[0, 1] == pytest.approx(84.0)
+    assert a.state.energy[0, 0] == pytest.approx(200.0 - 3.0 + 9.0)
+    assert a.state.score[0, 0].sum() == 0.0

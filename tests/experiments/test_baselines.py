@@ -157,3 +157,24 @@ def test_tiny_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     # a second call reuses every cached result (same numbers)
     again = baselines_outcome(1, tmp_path / "out", 4, 1, cfg)
     assert again.tables == outcome.tables
+
+
+@sb3_only
+def test_dead_tanks_pad_until_their_round_ends() -> None:
+    from confront.experiments.baselines import SharedTeamVecEnv
+
+    vec = SharedTeamVecEnv("4v4", 1, seed=5, opponents="td", td=_td())
+    vec.reset()
+    padded = 0
+    for step in range(400):
+        obs, rewards, dones, infos = vec.step(_actions(step, 4))
+        for k in range(4):
+            if dones[k] and infos[k]["padding"]:
+                padded += 1
+                assert rewards[k] == 0.0  # a dead tank earns nothing
+                assert not infos[k]["TimeLimit.truncated"]
+        if vec.rounds_done:
+            break
+    assert vec.rounds_done == 1
+    assert padded > 0 and vec.padding_steps == padded
+    assert vec.live_steps + vec.padding_steps == 4 * (step + 1)

@@ -70,7 +70,7 @@ def _run_job(job: Job, rounds: int | None) -> str:
     if (job.folder / "checkpoints" / "LATEST").exists():
         train_run(None, job.folder, resume=True, progress=False)
         return "resumed"
-    extra = [f"train.seed={job.seed}"]
+    extra = [f"train.seed={job.seed}", "train.replay=false"]
     if rounds is not None:
         extra.append(f"train.rounds={rounds}")
         extra.append(f"train.session_rounds={max(1, min(10, rounds // 2))}")
@@ -308,13 +308,13 @@ def _head_values(folders: Sequence[Path], head: int) -> np.ndarray:
     return np.array(out)
 
 
-def migration_outcome(seeds: int, out: Path, episodes: int | None) -> Outcome:
+def migration_outcome(seeds: int, out: Path, episodes: int | None, workers: int = 1) -> Outcome:
     """§6.2: delegated to confront.learning.migration (no arena needed)."""
     from confront.learning import migration as mig
 
     o = Outcome("migration")
     start = time.time()
-    kwargs = {"seeds": seeds}
+    kwargs: dict = {"seeds": seeds, "workers": workers}
     if episodes is not None:
         kwargs["episodes"] = episodes
     result = mig.run_migration(**kwargs)
@@ -410,7 +410,7 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
         click.echo(f"== {name}")
         start = time.time()
         if name == "migration":
-            outcomes.append(migration_outcome(max(seeds or 30, 2), out, episodes))
+            outcomes.append(migration_outcome(max(seeds or 30, 2), out, episodes, workers))
         elif name == "baselines":
             from confront.experiments.baselines import baselines_outcome
 

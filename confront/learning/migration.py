@@ -261,7 +261,7 @@ def paper_claims(result: MigrationResult) -> list[dict[str, Any]]:
         claims.append({
             "text": "Q_15 converges first, then Q_7, then Q_3",
             "ours": ours,
-            "holds": bool(med[15] <= med[7] <= med[3]),
+            "holds": bool(np.isfinite(med[3]) and med[15] <= med[7] <= med[3]),
         })
         others = [m for m in s if m != "ssaq"]
         if others:

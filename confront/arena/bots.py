@@ -514,10 +514,11 @@ class ScriptedBots:
         self.arena = arena
         self.names = list(names)
         self.kinds = np.array([bot_kind(n) for n in names], dtype=np.int64)
+        self._bots = np.flatnonzero(self.kinds != K_NONE)
         self.mem = np.zeros((arena.n_battles, arena.n_robots, M_SIZE))
-        self._rem = np.zeros((8, 4))
         self._apply_flags()
         self._round = arena.state.round.copy()
+        self._chunk_args()
         self.reset()
 
     def _apply_flags(self) -> None:
@@ -554,36 +555,40 @@ class ScriptedBots:
 
     def commands(self, cmd: np.ndarray) -> np.ndarray:
         """Fill the scripted robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""
-        s = self.arena.state
-        new_round = s.round != self._round
-        if new_round.any():
-            self.reset(new_round)
-            self._round[:] = s.round
-        bots = self.kinds != K_NONE
-        cmd[:, bots, :4] = np.nan
-        cmd[:, bots, 4] = 0.0
-        nb, workers = self.arena.n_battles, self.arena.threads
-        if nb >= 64 and workers > 1:
-            size = -(-nb // workers)
-            futures = [_pool(workers).submit(self._run, slice(lo, min(nb, lo + size)), cmd, k)
-                       for k, lo in enumerate(range(0, nb, size))]
+        rnd = self.arena.state.round
+        if not np.array_equal(rnd, self._round):
+            self.reset(rnd != self._round)
+            self._round[:] = rnd
+        cmd[:, self._bots, :4] = np.nan
+        cmd[:, self._bots, 4] = 0.0
+        if len(self._chunks) > 1:
+            workers = self.arena.threads
+            futures = [_pool(workers).submit(self._run, k, cmd) for k in range(len(self._chunks))]
             for f in futures:
                 f.result()
         else:
-            self._run(slice(None), cmd, 0)
+            self._run(0, cmd)
         return cmd
 
-    def _run(self, r: slice, cmd: np.ndarray, k: int) -> None:
-        """bots_step on the battles of slice r (k: which scratch row)."""
-        s = self.arena.state
-        if k >= len(self._rem):
-            self._rem = np.zeros((k + 1, 4))
-        bots_step(self.kinds, self.mem[r], s.x[r], s.y[r], s.heading[r], s.gun_heading[r], s.radar_heading[r],
-                  s.energy[r], s.alive[r], s.team[r], s.distance_remaining[r], s.body_turn_remaining[r],
-                  s.gun_turn_remaining[r], s.radar_turn_remaining[r], s.max_velocity[r], s.fire_assist[r],
-                  s.scan_request[r], s.scanned[r], s.ev_hit_wall[r], s.ev_hit_robot[r], s.ev_hit_robot_bearing[r],
-                  s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r], s.ev_died[r],
-                  float(self.arena.scenario.width), float(self.arena.scenario.height), cmd[r], self._rem[k])
+    def _chunk_args(self) -> None:
+        """Argument tuples of bots_step per battle chunk (views of the arena state: built once)."""
+        s, nb, workers = self.arena.state, self.arena.n_battles, self.arena.threads
+        size = -(-nb // workers) if nb >= 64 and workers > 1 else nb
+        self._chunks = []
+        for lo in range(0, nb, size):
+            r = slice(lo, min(nb, lo + size))
+            self._chunks.append((r, (
+                self.kinds, self.mem[r], s.x[r], s.y[r], s.heading[r], s.gun_heading[r], s.radar_heading[r],
+                s.energy[r], s.alive[r], s.team[r], s.distance_remaining[r], s.body_turn_remaining[r],
+                s.gun_turn_remaining[r], s.radar_turn_remaining[r], s.max_velocity[r], s.fire_assist[r],
+                s.scan_request[r], s.scanned[r], s.ev_hit_wall[r], s.ev_hit_robot[r], s.ev_hit_robot_bearing[r],
+                s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r], s.ev_died[r],
+                float(self.arena.scenario.width), float(self.arena.scenario.height)), np.zeros(4)))
+
+    def _run(self, k: int, cmd: np.ndarray) -> None:
+        """bots_step on battle chunk k."""
+        r, args, rem = self._chunks[k]
+        bots_step(*args, cmd[r], rem)
 
 
 def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20,

@@ -124,6 +124,10 @@ class Arena:
         width = max(r, self.state.n_bullet_slots) + 1
         self._scratch_i = np.zeros((b, 5, width), dtype=np.int32)
         self._scratch_f = np.zeros((b, 3, r), dtype=np.float64)
+        p = self.state.packed
+        self._args = ((p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
+                       p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
+                       p["placements_total"]), (self.params, self._scratch_i, self._scratch_f))
         self.seed(seed)
         self.reset()
 
@@ -178,15 +182,16 @@ class Arena:
 
     def step(self, commands: np.ndarray) -> None:
         """Advance every battle that is not done by one turn."""
-        cmd = np.asarray(commands, dtype=np.float64)
+        cmd = commands if type(commands) is np.ndarray and commands.dtype == np.float64 else \
+            np.asarray(commands, dtype=np.float64)
         if cmd.shape != (self.n_battles, self.n_robots, 5):
             raise ValueError(f"commands must have shape ({self.n_battles}, {self.n_robots}, 5), got {cmd.shape}")
-        if not np.all(np.isfinite(cmd[..., 4])):
+        if not cmd.flags.c_contiguous:
+            cmd = np.ascontiguousarray(cmd)
+        if not np.isfinite(cmd[..., 4].sum()):
             raise ValueError("commands[..., 4] (fire power) must be finite; use 0 for no fire")
-        p = self.state.packed
-        args = (p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
-                p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
-                p["placements_total"], cmd, self.params, self._scratch_i, self._scratch_f)
+        head, tail = self._args
+        args = (*head, cmd, *tail)
         b, workers = self.n_battles, self.threads
         if b >= _PARALLEL_MIN_BATTLES and workers > 1:
             size = -(-b // workers)

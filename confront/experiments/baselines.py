@@ -77,8 +77,16 @@ class BaselinesConfig:
     def __post_init__(self) -> None:
         if self.eval_rounds < 1:
             raise ValueError(f"eval_rounds must be >= 1, got {self.eval_rounds}")
+        from confront.arena.bots import BOT_NAMES
+
         if not self.opponents:
             raise ValueError("opponents must name at least one opponent")
+        for name in self.opponents:
+            if name != "td" and name not in BOT_NAMES:
+                raise ValueError(f"opponent {name!r} is neither 'td' nor one of {', '.join(BOT_NAMES)}")
+        for name in self.scripted:
+            if name not in BOT_NAMES:
+                raise ValueError(f"scripted robot {name!r} is not one of {', '.join(BOT_NAMES)}")
         for name in self.sb3:
             if name not in SB3_METHODS:
                 raise ValueError(f"sb3 method {name!r} is not one of {', '.join(SB3_METHODS)}")
@@ -102,6 +110,8 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
 
     def __init__(self, scenario: Any, n_battles: int, seed: int, opponents: str = "td",
                  td: Learner | None = None, config: SMDPConfig | None = None) -> None:
+        if not HAVE_SB3:
+            raise ImportError("SharedTeamVecEnv needs stable-baselines3: pip install 'confront[baselines]'")
         from gymnasium import spaces
 
         from confront.arena.gym_env import make_observation_space
@@ -124,10 +134,7 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
         self._feats = np.zeros((n_battles, self.env.n_robots, self.env.n_features), dtype=np.float32)
         obs_space = make_observation_space(self.env.n_features)["features"]
         n = n_battles * self.ours.size
-        if HAVE_SB3:
-            super().__init__(n, obs_space, spaces.Discrete(self.env.n_actions))
-        else:
-            raise ImportError("SharedTeamVecEnv needs stable-baselines3: pip install 'confront[baselines]'")
+        super().__init__(n, obs_space, spaces.Discrete(self.env.n_actions))
 
     def _flat(self, feats: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(feats[:, self.ours].reshape(self.num_envs, -1), dtype=np.float32)
@@ -266,12 +273,14 @@ def _pooled_ratio(rows: Sequence[dict[str, Any]], flip: bool = False) -> tuple[f
     return o, t, o / (o + t) if o + t > 0 else 0.5
 
 
-def _evaluate(cfg: BaselinesConfig, exp: Any, policy: Learner | None, scripted: str | None, seed: int,
-              td_path: Path) -> list[dict[str, Any]]:
+def _evaluate(cfg: BaselinesConfig, exp: Any, seed: int, td_path: Path, policy: Learner | None = None,
+              scripted: str = "") -> list[dict[str, Any]]:
     """Score rows of one method (a policy, or a scripted robot as our team) against every opponent."""
     from confront.experiments.evaluate import sim_bot_battle, sim_evaluate
     from confront.experiments.train import load_model
 
+    if (policy is None) == (not scripted):
+        raise ValueError("evaluate either a policy or a scripted robot")
     out = []
     for opp in cfg.opponents:
         eval_seed = cfg.eval_seed + seed
@@ -279,9 +288,9 @@ def _evaluate(cfg: BaselinesConfig, exp: Any, policy: Learner | None, scripted: 
             o, t, r = _pooled_ratio(sim_evaluate(exp, policy, opp, cfg.eval_rounds, eval_seed, str(td_path)))
         elif opp == "td":  # the TD team plays as team 0 (TeamBattleEnv's learning side), the robot as team 1
             td, _ = load_model(td_path)
-            o, t, r = _pooled_ratio(sim_evaluate(exp, td, scripted or "", cfg.eval_rounds, eval_seed), flip=True)
+            o, t, r = _pooled_ratio(sim_evaluate(exp, td, scripted, cfg.eval_rounds, eval_seed), flip=True)
         else:
-            res = sim_bot_battle(exp.arena.scenario, [scripted or "", opp], cfg.eval_rounds, eval_seed)
+            res = sim_bot_battle(exp.arena.scenario, [scripted, opp], cfg.eval_rounds, eval_seed)
             o = sum(c.total for c in res.contestants if c.name.endswith("team 0"))
             t = sum(c.total for c in res.contestants if not c.name.endswith("team 0"))
             r = o / (o + t) if o + t > 0 else 0.5
@@ -343,7 +352,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
     exp = _experiment(cfg, seed, rounds)
     extra: dict[str, Any] = {"train_rounds": 0, "train_seconds": 0.0}
     policy: Learner | None = None
-    scripted: str | None = None
+    scripted = ""
     if method in SB3_METHODS:
         model, info = train_sb3(method, cfg, seed, rounds)
         policy = SB3Policy(model, int(model.action_space.n))
@@ -366,7 +375,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
         scripted = method
         _, td_path = td_team(exp, smdp_config(exp).n_actions)
     rows = [{"method": method, "seed": seed, **r, **extra}
-            for r in _evaluate(cfg, exp, policy, scripted, seed, td_path)]
+            for r in _evaluate(cfg, exp, seed, td_path, policy, scripted)]
     folder.mkdir(parents=True, exist_ok=True)
     ck.write_atomic(done, json.dumps(rows, indent=1).encode())
     return rows

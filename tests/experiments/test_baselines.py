@@ -38,6 +38,10 @@ def test_config_rejects_bad_values() -> None:
         BaselinesConfig(sb3=("A2C",))
     with pytest.raises(ValueError, match="opponents"):
         BaselinesConfig(opponents=())
+    with pytest.raises(ValueError, match="'Nobody'"):
+        BaselinesConfig(opponents=("td", "Nobody"))
+    with pytest.raises(ValueError, match="'Sitter'"):
+        BaselinesConfig(scripted=("Sitter",))
 
 
 def test_rank_table_orders_by_first_opponent_and_lists_skipped() -> None:

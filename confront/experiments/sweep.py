@@ -67,7 +67,8 @@ def read_grid(path: str | Path, seeds: int | None = None) -> tuple[str, list[Tri
     trials = []
     for combo in itertools.product(*(grid[k] for k in keys)) if keys else [()]:
         point_overrides = tuple(f"{k}={_value_text(v)}" for k, v in zip(keys, combo, strict=True))
-        point = ",".join(f"{k.split('.')[-1]}={v}" for k, v in zip(keys, combo, strict=True)) or "base"
+        point = ",".join(f"{k.split('.')[-1]}={v if isinstance(v, str) else _value_text(v)}"
+                         for k, v in zip(keys, combo, strict=True)) or "base"
         load_experiment(base, fixed + point_overrides)  # fail fast on a bad grid value
         for seed in range(n_seeds):
             safe = "".join(c if c.isalnum() or c in "=.,-_" else "_" for c in point)

@@ -105,8 +105,7 @@ def _opponent(cfg: ExperimentConfig, obs_cfg: ObservationConfig, robots: Path,
     if kind != "td":
         return robot_class(kind), [], {}
     td, where = td_team(cfg, N_MOVES, progress=progress)
-    policy = ExportedPolicy("qtable", q=np.asarray(td.q, dtype=np.float64), observation=obs_cfg,
-                            step_turns=cfg.arena.decision_turns)
+    policy = ExportedPolicy.from_learner(td, observation=obs_cfg, step_turns=cfg.arena.decision_turns)
     folder = export_robot(policy, robots)
     info: dict[str, Any] = {"td_model": str(where)}
     if cfg.opponent.learning:

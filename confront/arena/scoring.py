@@ -8,32 +8,11 @@ number half up (``(int)(x + 0.5)``); :func:`round_half_up` does the same.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-
 import numpy as np
 
-from .state import SCORE_PARTS
+from confront.results import BattleResults, ScoreRow
 
-__all__ = ["ScoreRow", "round_half_up", "team_scores", "team_placements", "score_share", "score_ratio",
-           "defensive_score", "results_table", "format_results"]
-
-
-@dataclass(frozen=True)
-class ScoreRow:
-    """One contestant's battle result: total, the six parts, 1sts/2nds/3rds."""
-
-    name: str
-    total: float
-    parts: dict[str, float]
-    firsts: int
-    seconds: int
-    thirds: int
-
-
-def round_half_up(x: float) -> int:
-    """Robocode's rounding of result numbers: (int)(x + 0.5) (truncation toward zero, as Java casts)."""
-    return int(math.trunc(x + 0.5))
+__all__ = ["team_scores", "team_placements", "score_share", "score_ratio", "defensive_score", "results_table"]
 
 
 def team_scores(score: np.ndarray, team: np.ndarray, n_teams: int) -> np.ndarray:
@@ -69,26 +48,12 @@ def defensive_score(score: np.ndarray, team: np.ndarray, n_teams: int) -> np.nda
 
 
 def results_table(score_total: np.ndarray, placements_total: np.ndarray, team: np.ndarray,
-                  names: list[str]) -> list[ScoreRow]:
+                  names: list[str], rounds: int = 1) -> BattleResults:
     """One battle's contestants ranked best first; ``score_total`` (R, 6), ``names`` one per team."""
     n_teams = len(names)
     ts = team_scores(score_total[None], team, n_teams)[0]
     tp = team_placements(placements_total[None], team, n_teams)[0]
-    rows = [ScoreRow(names[k], float(ts[k].sum()), dict(zip(SCORE_PARTS, map(float, ts[k]), strict=True)),
-                     int(tp[k, 0]), int(tp[k, 1]), int(tp[k, 2])) for k in range(n_teams)]
-    return sorted(rows, key=lambda r: -r.total)
-
-
-def format_results(rows: list[ScoreRow], rounds: int) -> str:
-    """Text like Robocode's results file (numbers rounded half up, share of the total in percent)."""
-    grand = sum(r.total for r in rows)
-    ordinal = {1: "1st", 2: "2nd", 3: "3rd"}
-    lines = [f"Results for {rounds} rounds",
-             "Robot Name\tTotal Score\tSurvival\tSurv Bonus\tBullet Dmg\tBullet Bonus\tRam Dmg * 2\tRam Bonus"
-             "\t1sts\t2nds\t3rds"]
-    for i, r in enumerate(rows, start=1):
-        pct = round_half_up(100 * r.total / grand) if grand > 0 else 0
-        parts = "\t".join(str(round_half_up(r.parts[p])) for p in SCORE_PARTS)
-        lines.append(f"{ordinal.get(i, f'{i}th')}: {r.name}\t{round_half_up(r.total)} ({pct}%)\t{parts}"
-                     f"\t{r.firsts}\t{r.seconds}\t{r.thirds}")
-    return "\n".join(lines)
+    rows = [ScoreRow(names[k], float(ts[k].sum()), *map(float, ts[k]), firsts=int(tp[k, 0]), seconds=int(tp[k, 1]),
+                     thirds=int(tp[k, 2]), team=names[k]) for k in range(n_teams)]
+    rows.sort(key=lambda r: -r.total)
+    return BattleResults(rounds=rounds, contestants=tuple(rows), engine="sim")

@@ -2,8 +2,8 @@
 
 from confront.engine.battle import BattleSpec, Team, scenario_battle
 from confront.engine.install import EngineInstall, EngineNotFoundError, engine_available, find_engine
-from confront.engine.results import BattleResults, ScoreRow, parse_results_text
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
+from confront.results import BattleResults, ScoreRow, parse_results_text
 
 __all__ = [
     "BattleResults", "BattleSpec", "EngineInstall", "EngineNotFoundError", "EngineOptions", "EngineRun",

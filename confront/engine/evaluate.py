@@ -10,8 +10,8 @@ from pathlib import Path
 from confront.engine.battle import BattleSpec, scenario_battle
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
-from confront.engine.results import BattleResults
 from confront.engine.runner import EngineOptions, run_battle
+from confront.results import BattleResults
 
 MODES = ("export", "bridge")
 

@@ -16,8 +16,8 @@ from typing import Any
 from confront.engine.battle import BattleSpec
 from confront.engine.install import JVM_FLAGS, EngineInstall, find_engine
 from confront.engine.java_build import compile_java
-from confront.engine.results import BattleResults, ScoreRow, parse_results_text
 from confront.engine.workdir import prepare_workdir, write_robot_data
+from confront.results import BattleResults, ScoreRow, parse_results_text
 
 RUNNER_CLASS = "confront.ConfrontRunner"
 

@@ -13,10 +13,10 @@ import numpy as np
 
 from confront.arena.smdp import TeamBattleEnv
 from confront.config import load_toml
-from confront.engine.results import BattleResults, ScoreRow
 from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.experiments.train import Loop, Side, _run, load_model, scenario_of, smdp_config
 from confront.learning.base import Learner
+from confront.results import BattleResults, ScoreRow
 
 PARTS = ("survival", "last_survivor", "bullet_damage", "bullet_kill_bonus", "ram_damage", "ram_kill_bonus")
 

@@ -7,9 +7,7 @@ from confront.arena.core import Arena
 from confront.arena.scenarios import get_scenario
 from confront.arena.scoring import (
     defensive_score,
-    format_results,
     results_table,
-    round_half_up,
     score_ratio,
     score_share,
     team_scores,
@@ -60,14 +58,9 @@ def test_team_sums_shares_and_ratio():
     assert score_share(np.zeros((1, 4, 6)), team, 2)[0].tolist() == [0.0, 0.0]
 
 
-def test_round_half_up_like_java():
-    assert [round_half_up(v) for v in (0.5, 1.49, 2.5, 14.94, 99.6)] == [1, 1, 3, 15, 100]
-
-
 def test_results_text():
     score = np.array([[50.0, 10, 100, 20, 0, 0], [0.0] * 6])
     places = np.array([[1, 0, 0], [0, 1, 0]])
-    rows = results_table(score, places, np.array([0, 1]), ["sample.Walls", "sample.SpinBot"])
-    text = format_results(rows, 1)
+    text = results_table(score, places, np.array([0, 1]), ["sample.Walls", "sample.SpinBot"]).to_results_text()
     assert text.splitlines()[2] == "1st: sample.Walls\t180 (100%)\t50\t10\t100\t20\t0\t0\t1\t0\t0"
     assert text.splitlines()[3].startswith("2nd: sample.SpinBot\t0 (0%)")

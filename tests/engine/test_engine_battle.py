@@ -12,8 +12,8 @@ import pytest
 
 from confront.engine.battle import BattleSpec
 from confront.engine.install import JVM_FLAGS, EngineInstall
-from confront.engine.results import parse_results_text
 from confront.engine.runner import EngineOptions, run_battle
+from confront.results import parse_results_text
 
 pytestmark = pytest.mark.engine
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from confront.engine.results import BattleResults, ScoreRow, parse_results_text, round_half_up
+from confront.results import BattleResults, ScoreRow, parse_results_text, round_half_up
 
 TEXT = (
     "Results for 3 rounds\n"

@@ -1,4 +1,4 @@
-"""Battle results as a table of Robocode's score parts, per contestant and per robot.
+"""Battle results as a table of Robocode's score parts, per contestant and per robot (simulator and engine).
 
 The same type is filled by the real engine (exact doubles from its score snapshots, or the integers of a
 results file) and by the simulator. Columns follow Robocode's results table.
@@ -111,6 +111,18 @@ class BattleResults:
             cells = [f"{v:.{digits}f}" if isinstance(v, float) else str(v) for v in row.values()]
             lines.append(f"| {rank} | {row.name} | " + " | ".join(cells) + " |")
         return "\n".join(lines) + "\n"
+
+    def to_results_text(self) -> str:
+        """Text like the engine's ``-results`` file: numbers rounded half up, share of the total in percent."""
+        grand = sum(r.total for r in self.contestants)
+        ordinal = {1: "1st", 2: "2nd", 3: "3rd"}
+        lines = [f"Results for {self.rounds} rounds", "Robot Name\t" + "\t".join(ENGINE_HEADERS)]
+        for i, r in enumerate(self.contestants, start=1):
+            pct = round_half_up(100 * r.total / grand) if grand > 0 else 0
+            parts = "\t".join(str(round_half_up(getattr(r, f))) for f in SCORE_FIELDS[1:7])
+            lines.append(f"{ordinal.get(i, f'{i}th')}: {r.name}\t{round_half_up(r.total)} ({pct}%)\t{parts}"
+                         f"\t{r.firsts}\t{r.seconds}\t{r.thirds}")
+        return "\n".join(lines)
 
     def _rows(self, level: str) -> tuple[ScoreRow, ...]:
         if level == "contestants":

@@ -33,6 +33,7 @@ from numba import njit
 
 from .core import Arena, _pool
 from .rules import normal_absolute_angle, normal_relative_angle
+from .scenarios import Scenario
 
 __all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind", "bot_battle"]
 
@@ -591,10 +592,11 @@ class ScriptedBots:
         bots_step(*args, cmd[r], rem)
 
 
-def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20,
-               turns_after_end: int = 150) -> tuple[np.ndarray, np.ndarray]:
-    """Free-for-all of scripted robots over ``rounds`` rounds (spread over parallel battles).
+def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20, turns_after_end: int = 150,
+               scenario: Scenario | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Scripted robots over ``rounds`` rounds (spread over parallel battles); a free-for-all by default.
 
+    ``names``: one bot per robot of ``scenario`` (default: a melee of ``len(names)`` single robots).
     Returns the score parts (R, 6) and placements (R, 3) summed over the rounds, robot order as
     ``names``; the score share of robot i is ``parts[i].sum() / parts.sum()``.
     """
@@ -603,8 +605,10 @@ def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20
     if rounds < 1:
         raise ValueError(f"rounds must be >= 1, got {rounds}")
     n_battles = min(n_battles, rounds)
-    sc = get_scenario("melee").replace(teams=tuple(1 for _ in names), turns_after_end=turns_after_end,
-                                       max_turns=100000)
+    base = scenario if scenario is not None else get_scenario("melee").replace(teams=tuple(1 for _ in names))
+    if base.n_robots != len(names):
+        raise ValueError(f"scenario {base.name} has {base.n_robots} robots, got {len(names)} names")
+    sc = base.replace(turns_after_end=turns_after_end, max_turns=100000)
     arena = Arena(sc, n_battles, seed=seed)
     bots = ScriptedBots(arena, list(names))
     quota = np.full(n_battles, rounds // n_battles)

@@ -98,42 +98,18 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
 
 def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int) -> BattleResults:
     """Scripted robots in the simulator: one name per team (a team is filled with copies of its robot)."""
-    from confront.arena.bots import ScriptedBots
-    from confront.arena.core import Arena
+    from confront.arena.bots import bot_battle
+    from confront.arena.scoring import results_table
 
     sc = scenario_of(scenario)
     if len(robots) != len(sc.teams):
         raise click.UsageError(f"scenario {sc.name} has {len(sc.teams)} teams: give {len(sc.teams)} robots, "
                                f"got {','.join(robots)}")
-    per_robot = [robots[t] for t in sc.team_ids()]
-    n = min(16, rounds)
-    arena = Arena(sc.replace(turns_after_end=150, max_turns=100000), n, seed=seed)
-    bots = ScriptedBots(arena, per_robot)
-    quota = np.full(n, rounds // n)
-    quota[: rounds % n] += 1
-    played = np.zeros(n, dtype=np.int64)
-    cmd = arena.idle_commands()
-    s = arena.state
-    while (played < quota).any():
-        bots.commands(cmd)
-        arena.step(cmd)
-        if s.done.any():
-            played += s.done
-            again = s.done & (played < quota)
-            if again.any():
-                arena.reset(again)
     team = np.asarray(sc.team_ids())
-    totals = s.score_total.sum(axis=0)
-    places = s.placements_total.sum(axis=0)
-    rows = []
-    for k, name in enumerate(robots):
-        parts = totals[team == k].sum(axis=0)
-        pl = places[team == k].sum(axis=0) if sc.teams[k] == 1 else places[team == k][0]
-        label = name if len(sc.teams) > 1 and sc.teams[k] == 1 else f"{name} team {k}"
-        rows.append(ScoreRow(label, float(parts.sum()), *map(float, parts), firsts=int(pl[0]), seconds=int(pl[1]),
-                             thirds=int(pl[2]), team=label))
-    rows.sort(key=lambda r: -r.total)
-    return BattleResults(rounds=rounds, contestants=tuple(rows), engine="sim")
+    parts, places = bot_battle([robots[t] for t in team], rounds, seed=seed, n_battles=16, scenario=sc)
+    labels = [name if size == 1 else f"{name} team {k}"
+              for k, (name, size) in enumerate(zip(robots, sc.teams, strict=True))]
+    return results_table(parts, places, team, labels, rounds=rounds)
 
 
 def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed: int,

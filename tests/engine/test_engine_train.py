@@ -10,11 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from confront.engine.results import parse_results_text
 from confront.engine.train import ENGINE_PARTS, round_rows, train_in_engine
 from confront.experiments.spec import load_experiment
 from confront.experiments.train import load_model, save_model, td_learner
 from confront.learning.tabular import TabularParams, TabularQ
+from confront.results import parse_results_text
 
 
 def _robot(contestant: int, alive: bool, **parts: float) -> dict[str, Any]:
@@ -90,6 +90,11 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path) -> 
         assert sum(float(r[f"score_{side}"]) for r in rows) == pytest.approx(row.total, abs=0.5)
     assert ours.total > 0  # it hit the duck
     assert summary["rounds"] == rounds and summary["sessions"] == rounds
+    sim_keys = {"name", "run", "scenario", "rounds", "sessions", "decisions", "final_score_ratio",
+                "final_window_rounds", "win_rate_last", "score_ours", "score_theirs", "learner", "wall_time_s",
+                "figures", "replay", "n_actions", "n_features"}  # train_run's summary (simulator)
+    assert sim_keys <= summary.keys() and {"skipped_turns", "bridge_failures"} <= summary.keys()
+    assert summary["score_ours"] == pytest.approx(ours.total, abs=0.5)
     # a robot whose Python answer is late on a loaded machine falls back for the rest of its round: reported,
     # not fatal, so only protocol errors are ruled out here
     assert summary["bridge_errors"] == [] and all("bridge-failed" in f for f in summary["bridge_failures"])

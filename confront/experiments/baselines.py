@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
-from confront.experiments.reproduce import Job, Outcome, _slug, run_jobs
+from confront.experiments.reproduce import Claim, Job, Outcome, _slug, run_jobs
 from confront.experiments.stats import Interval, interval
 from confront.learning.base import Learner, Transition
 
@@ -495,5 +495,10 @@ def baselines_outcome(n_seeds: int, out: Path, rounds: int | None, workers: int,
              f"every method: {cfg.eval_rounds} greedy evaluation rounds per opponent, pooled per seed).")
     (root / "ranking.md").write_text(intro + "\n\n" + table + "\n")
     (root / "config.json").write_text(json.dumps({**asdict(cfg), "seeds": n_seeds, "rounds": rounds}, indent=1))
-    return Outcome("baselines", claims=[], figures=[fig], tables=[intro, "", table, ""],
+    first = cfg.opponents[0]
+    order = sorted((m for m in stats if first in stats[m]), key=lambda m: -stats[m][first].mean)
+    claim = Claim(f"beyond the paper: ranking by score ratio vs {'the TD team' if first == 'td' else first}", "-",
+                  "; ".join(f"{i}. {m} {stats[m][first]}" for i, m in enumerate(order, 1)), None,
+                  detail=f"n = {n_seeds} seeds")
+    return Outcome("baselines", claims=[claim], figures=[fig], tables=[intro, "", table, ""],
                    seconds=time.time() - start)

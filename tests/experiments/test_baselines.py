@@ -158,9 +158,25 @@ def test_tiny_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     if not HAVE_SB3:
         assert "skipped: stable_baselines3/torch not installed" in table
     assert outcome.figures and outcome.figures[0].exists()
+    assert len(outcome.claims) == 1 and outcome.claims[0].holds is None
+    assert outcome.claims[0].ours.startswith("1. ")
     # a second call reuses every cached result (same numbers)
     again = baselines_outcome(1, tmp_path / "out", 4, 1, cfg)
     assert again.tables == outcome.tables
+
+
+def test_without_sb3_the_table_says_skipped(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from confront.experiments import baselines
+
+    monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(baselines, "HAVE_SB3", False)  # what a core install (no torch) sees
+    cfg = BaselinesConfig(overrides=("opponent.pretrain_rounds=2", "train.replay=false", "arena.battles=2"),
+                          eval_rounds=2, scripted=("Walls",), opponents=("SpinBot",))
+    outcome = baselines.baselines_outcome(1, tmp_path / "out", 2, 1, cfg)
+    table = "\n".join(outcome.tables)
+    assert "| DQN (SB3) | skipped: stable_baselines3/torch not installed" in table
+    assert "| PPO (SB3) | skipped:" in table
+    assert "| DMNN (FLM) |" in table and "| Walls |" in table
 
 
 @sb3_only

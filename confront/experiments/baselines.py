@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
-from confront.experiments.reproduce import Claim, Job, Outcome, _slug, run_jobs
+from confront.experiments.reproduce import Claim, Job, Outcome, run_jobs, slug
 from confront.experiments.stats import Interval, interval
 from confront.learning.base import Learner, Transition
 
@@ -465,7 +465,7 @@ def baselines_outcome(n_seeds: int, out: Path, rounds: int | None, workers: int,
     start = time.time()
     # 1. the paper's method, as the paper's arms are trained (this also builds each seed's TD team)
     dmnn = [Job("baselines", DMNN_METHOD, s, cfg.base, cfg.overrides + ("learner.learning_rate=\"fuzzy\"",),
-                runs / _slug(DMNN_METHOD) / f"seed-{s}") for s in range(n_seeds)]
+                runs / slug(DMNN_METHOD) / f"seed-{s}") for s in range(n_seeds)]
     run_jobs(dmnn, rounds, workers)
     # 2. SB3 methods (trained here) and scripted robots, evaluated on the same seeds
     skipped: dict[str, str] = {}
@@ -478,7 +478,7 @@ def baselines_outcome(n_seeds: int, out: Path, rounds: int | None, workers: int,
     methods += list(cfg.scripted)
     tasks = [(m, s) for m in methods for s in range(n_seeds)]
 
-    args = [(m, cfg, s, rounds, root / "eval" / _slug(m) / f"seed-{s}", dmnn[s].folder) for m, s in tasks]
+    args = [(m, cfg, s, rounds, root / "eval" / slug(m) / f"seed-{s}", dmnn[s].folder) for m, s in tasks]
     if workers <= 1:
         results = [_method_job(*a) for a in args]
     else:

@@ -163,13 +163,13 @@ def level_claim(text: str, figure: str, values: np.ndarray, target: float, tol: 
 def _arm_jobs(experiment: str, base: str, arms: dict[str, tuple[str, ...]], seeds: int, out: Path,
               prefix: tuple[str, ...] = ()) -> dict[str, list[Job]]:
     return {
-        arm: [Job(experiment, arm, s, base, prefix + ov, out / experiment / "runs" / _slug(arm) / f"seed-{s}")
+        arm: [Job(experiment, arm, s, base, prefix + ov, out / experiment / "runs" / slug(arm) / f"seed-{s}")
               for s in range(seeds)]
         for arm, ov in arms.items()
     }
 
 
-def _slug(text: str) -> str:
+def slug(text: str) -> str:
     return "".join(c if c.isalnum() else "-" for c in text.lower()).strip("-")
 
 

@@ -10,9 +10,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from confront.engine.train import ENGINE_PARTS, round_rows, train_in_engine
 from confront.experiments.spec import load_experiment
 from confront.experiments.train import load_model, save_model, td_learner
+from confront.experiments.train_engine import ENGINE_PARTS, round_rows, train_in_engine
 from confront.learning.tabular import TabularParams, TabularQ
 from confront.results import parse_results_text
 

@@ -410,7 +410,8 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
         click.echo(f"== {name}")
         start = time.time()
         if name == "migration":
-            outcomes.append(migration_outcome(max(seeds or 30, 2), out, episodes, workers))
+            # the tabular task is cheap: 3 seeds per requested seed (30 for the default 10), never fewer than 2
+            outcomes.append(migration_outcome(max(3 * n_seeds, 2), out, episodes, workers))
         elif name == "baselines":
             from confront.experiments.baselines import baselines_outcome
 

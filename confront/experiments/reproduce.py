@@ -333,7 +333,7 @@ def migration_outcome(seeds: int, out: Path, episodes: int | None, workers: int 
 # -- report ------------------------------------------------------------------------------------------------------
 
 def write_report(out: Path, outcomes: Sequence[Outcome], seeds: int, rounds: int | None) -> Path:
-    """``report.md`` and ``report.html``: claims table, figures, wall times."""
+    """``report.md`` and ``report.html`` in ``out``: claims table, figures (paths relative to ``out``), wall times."""
     lines = ["# confront: the paper's claims, re-run", "",
              f"Seeds per arm: {seeds}. Rounds per arm: {rounds or 'as in the paper (500)'}. "
              "Claims are tested on per-seed values of the last rounds (one-sided permutation test, p < 0.05; "
@@ -424,7 +424,8 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
         click.echo(f"   {name}: {outcomes[-1].seconds:.0f} s")
         (out / name).mkdir(parents=True, exist_ok=True)
         (out / name / "claims.json").write_text(json.dumps([c.__dict__ for c in outcomes[-1].claims], indent=1))
-    report = write_report(out, outcomes, n_seeds, rounds)
+    # `all` writes the report at the top; a single experiment writes <out>/<experiment>/report.md
+    report = write_report(out if experiment == "all" else out / experiment, outcomes, n_seeds, rounds)
     click.echo(f"report: {report}")
     return outcomes
 

@@ -63,12 +63,23 @@ class Outcome:
     runs: int = 0
 
 
-def _run_job(job: Job, rounds: int | None) -> str:
+def _run_job(job: Job, rounds: int | None, engine: str = "sim") -> str:
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import train_run
 
     if (job.folder / "summary.json").exists():
         return "cached"
+    if engine == "robocode":  # live in the real engine (no checkpoints there: an unfinished run restarts)
+        import shutil
+
+        from confront.experiments.train_engine import train_in_engine
+
+        shutil.rmtree(job.folder, ignore_errors=True)
+        extra = [f"train.seed={job.seed}"]
+        if rounds is not None:
+            extra += [f"train.rounds={rounds}", f"train.session_rounds={max(1, min(10, rounds // 2))}"]
+        train_in_engine(load_experiment(job.base, job.overrides + tuple(extra)), job.folder, progress=False)
+        return "trained"
     if (job.folder / "checkpoints" / "LATEST").exists():
         train_run(None, job.folder, resume=True, progress=False)
         return "resumed"
@@ -82,8 +93,13 @@ def _run_job(job: Job, rounds: int | None) -> str:
     return "trained"
 
 
-def run_jobs(jobs: Sequence[Job], rounds: int | None, workers: int) -> None:
-    """Run jobs in worker processes, respecting ``after`` dependencies, with one progress bar."""
+def run_jobs(jobs: Sequence[Job], rounds: int | None, workers: int, engine: str = "sim") -> None:
+    """Run jobs in worker processes, respecting ``after`` dependencies, with one progress bar.
+
+    ``engine="robocode"`` trains every run live in the real engine, one at a time (two engines on two cores
+    would skip turns)."""
+    if engine == "robocode":
+        workers = 1
     from tqdm import tqdm
 
     done: set[Path] = {j.folder for j in jobs if (j.folder / "summary.json").exists()}
@@ -94,7 +110,7 @@ def run_jobs(jobs: Sequence[Job], rounds: int | None, workers: int) -> None:
             while waiting:
                 job = next(j for j in waiting if all(a in done for a in j.after))
                 waiting.remove(job)
-                _run_job(job, rounds)
+                _run_job(job, rounds, engine)
                 done.add(job.folder)
                 bar.set_postfix_str(f"{job.experiment}/{job.arm}/s{job.seed} {time.time() - start:.0f}s")
                 bar.update(1)
@@ -399,9 +415,10 @@ def _write_html(path: Path, md: str) -> None:
 
 
 def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = None, out: Path | None = None,
-              workers: int | None = None, tail: int = 100, episodes: int | None = None) -> list[Outcome]:
-    """Run ``experiment`` (or ``all``) and write the report; return the outcomes."""
-    out = Path(out or "results")
+              workers: int | None = None, tail: int = 100, episodes: int | None = None, engine: str = "sim"
+              ) -> list[Outcome]:
+    """Run ``experiment`` (or ``all``) in the simulator or the real engine and write the report."""
+    out = Path(out or ("results" if engine == "sim" else "results-robocode"))
     out.mkdir(parents=True, exist_ok=True)
     names = [e for e in EXPERIMENTS if e != "baselines"] if experiment == "all" else [experiment]
     workers = workers or os.cpu_count() or 1
@@ -422,7 +439,7 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
             outcomes.append(baselines_outcome(n_seeds, out, rounds, workers))
         else:
             jobs, analyse = builders[name](n_seeds, out, rng, tail)
-            run_jobs(jobs, rounds, workers)
+            run_jobs(jobs, rounds, workers, engine)
             outcomes.append(analyse())
             outcomes[-1].runs = len(jobs)
             outcomes[-1].run_seconds = sum(json.loads((j.folder / "summary.json").read_text())["wall_time_s"]
@@ -439,12 +456,12 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
 
 def reproduce_cli(experiment: str, seeds: int | None, rounds: int | None, engine: str, out: Path | None,
                   workers: int | None, overrides: tuple[str, ...]) -> None:
-    if engine != "sim":
-        raise click.UsageError("reproduce --engine robocode is not available yet: train in the simulator, then "
-                               "`confront evaluate RUN --engine robocode`")
+    if engine == "robocode" and experiment in ("baselines", "all"):
+        raise click.UsageError("--engine robocode runs awm, fuzzy or transfer (hours at 500 rounds per run); "
+                               "migration needs no engine and the SB3 baselines train in the simulator")
     if overrides:
         raise click.UsageError("reproduce takes no --set: edit a copy of the experiment's TOML instead")
-    outcomes = reproduce(experiment, seeds=seeds, rounds=rounds, out=out, workers=workers)
+    outcomes = reproduce(experiment, seeds=seeds, rounds=rounds, out=out, workers=workers, engine=engine)
     for o in outcomes:
         for c in o.claims:
             mark = {True: "holds", False: "does NOT hold", None: "n/a"}[c.holds]

@@ -59,7 +59,10 @@ def test_ctrl_c_stops_the_engine(install, tmp_path) -> None:
     code = ("from confront.engine.battle import BattleSpec\n"
             "from confront.engine.runner import run_battle\n"
             "run_battle(BattleSpec(('SpinBot', 'Walls'), rounds=500))\n")
-    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    # Ctrl-C as from a terminal: a shell that started the test run in the background may have left SIGINT
+    # ignored, which the child would inherit (then Python installs no KeyboardInterrupt handler)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     java: list[int] = []
     deadline = time.monotonic() + 60
     while not java and time.monotonic() < deadline:  # wait for the engine process to start

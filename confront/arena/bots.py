@@ -541,6 +541,12 @@ class ScriptedBots:
         self.mem[idx, :, M_TARGET] = -1.0
         self._round[idx] = self.arena.state.round[idx]
 
+    def sync_rounds(self) -> None:
+        """Clear the memory of every battle that started a new round since the bots last acted."""
+        rnd = self.arena.state.round
+        if not np.array_equal(rnd, self._round):
+            self.reset(rnd != self._round)
+
     def state_dict(self) -> dict[str, np.ndarray]:
         """The bots' memory (data only), for checkpoints next to ``Arena.state_dict``."""
         return {"mem": self.mem.copy(), "round": self._round.copy()}
@@ -556,10 +562,7 @@ class ScriptedBots:
 
     def commands(self, cmd: np.ndarray) -> np.ndarray:
         """Fill the scripted robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""
-        rnd = self.arena.state.round
-        if not np.array_equal(rnd, self._round):
-            self.reset(rnd != self._round)
-            self._round[:] = rnd
+        self.sync_rounds()
         cmd[:, self._bots, :4] = np.nan
         cmd[:, self._bots, 4] = 0.0
         if len(self._chunks) > 1:

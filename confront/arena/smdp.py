@@ -230,7 +230,6 @@ class TeamBattleEnv:
         self.arena.new_battle()
         if self.bots is not None:
             self.bots.reset()
-            self.bots._round[:] = self.arena.state.round
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats
@@ -272,13 +271,8 @@ class TeamBattleEnv:
 
     def _sync_bots(self) -> None:
         """Scripted bots clear their memory when their battle started a new round (as ScriptedBots.commands)."""
-        bots = self.bots
-        if bots is not None:
-            rnd = self.arena.state.arrays["round"]
-            new_round = rnd != bots._round
-            if new_round.any():
-                bots.reset(new_round)
-                bots._round[:] = rnd
+        if self.bots is not None:
+            self.bots.sync_rounds()
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
@@ -342,19 +336,14 @@ class TeamBattleEnv:
         """Arena arrays plus the scripted bots' memory (data only)."""
         d = {f"arena.{k}": v for k, v in self.arena.state_dict().items()}
         if self.bots is not None:
-            d["bots.mem"] = self.bots.mem.copy()
-            d["bots.round"] = self.bots._round.copy()
+            d.update({f"bots.{k}": v for k, v in self.bots.state_dict().items()})
         return d
 
     def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
         """Restore what :meth:`state_dict` wrote."""
         self.arena.load_state_dict({k[6:]: v for k, v in d.items() if k.startswith("arena.")})
         if self.bots is not None:
-            for key in ("bots.mem", "bots.round"):
-                if key not in d:
-                    raise ValueError(f"state dict lacks {key!r}")
-            self.bots.mem[...] = d["bots.mem"]
-            self.bots._round[...] = d["bots.round"]
+            self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
         self._last = self.observe()
 
     def team_ids(self) -> np.ndarray:

@@ -609,6 +609,21 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     rb[b, TRWG, i] = (last[b, 0, i] == last[b, 1, i]) and (rf[b, GH, i] == rf[b, RH, i])
 
 
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _clear_events(b, i, rb, ri, scanned):
+    """Forget robot i's events and scans of the last turn (each turn starts with none)."""
+    rb[b, EVWALL, i] = False
+    rb[b, EVFAULT, i] = False
+    rb[b, EVFIRED, i] = False
+    rb[b, EVDIED, i] = False
+    ri[b, EVROBOT, i] = -1
+    ri[b, EVHITBY, i] = 0
+    ri[b, EVBHIT, i] = 0
+    ri[b, EVMISSED, i] = 0
+    for j in range(scanned.shape[2]):
+        scanned[b, i, j] = False
+
+
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                  placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order):
@@ -617,16 +632,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     mode = int(params[P_ORDER])
     bi[b, TIME] += 1
     for i in range(n):
-        rb[b, EVWALL, i] = False
-        rb[b, EVFAULT, i] = False
-        rb[b, EVFIRED, i] = False
-        rb[b, EVDIED, i] = False
-        ri[b, EVROBOT, i] = -1
-        ri[b, EVHITBY, i] = 0
-        ri[b, EVBHIT, i] = 0
-        ri[b, EVMISSED, i] = 0
-        for j in range(n):
-            scanned[b, i, j] = False
+        _clear_events(b, i, rb, ri, scanned)
     dead[n] = 0
     # robots are halted 120 turns after the decision (BaseBattle): the commands sent while being halted
     # are the last ones taken, and from then on a robot gains no energy (isExecFinishedAndDisabled)
@@ -847,16 +853,8 @@ def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
         rb[b, OVERDRIVE, i] = False
         rb[b, INCOLL, i] = False
         rb[b, TRWG, i] = False
-        rb[b, EVWALL, i] = False
-        rb[b, EVFAULT, i] = False
-        rb[b, EVFIRED, i] = False
-        rb[b, EVDIED, i] = False
-        ri[b, EVROBOT, i] = -1
-        ri[b, EVHITBY, i] = 0
-        ri[b, EVBHIT, i] = 0
-        ri[b, EVMISSED, i] = 0
+        _clear_events(b, i, rb, ri, scanned)
         for j in range(n):
-            scanned[b, i, j] = False
             scan_time[b, i, j] = -1
             ledger[b, i, j] = 0.0
         for k in range(6):

@@ -361,16 +361,20 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _turn_step(rem, rate):
+    """This turn's share of a remaining turn: all of it, or ``rate`` toward it (RobotPeer.update*Heading)."""
+    if rem > 0.0:
+        return rem if rem < rate else rate
+    return rem if rem > -rate else -rate
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _turn_body(rf, rb, b, i):
     """RobotPeer.updateHeading: at most min(maxTurnRate, 10 - 0.75|v|) deg; gun and radar follow."""
     rem = rf[b, BODYREM, i]
     if rem == 0.0:
         return
-    rate = turn_rate(rf[b, V, i], rf[b, MAXTURN, i])
-    if rem > 0.0:
-        step = rem if rem < rate else rate
-    else:
-        step = rem if rem > -rate else -rate
+    step = _turn_step(rem, turn_rate(rf[b, V, i], rf[b, MAXTURN, i]))
     rf[b, H, i] += step
     rf[b, GH, i] += step
     rf[b, RH, i] += step
@@ -391,10 +395,7 @@ def _turn_gun(rf, rb, b, i):
     """RobotPeer.updateGunHeading: at most 20 deg; the radar follows (adjusted if adjustRadarForGun)."""
     rem = rf[b, GUNREM, i]
     if rem != 0.0:
-        if rem > 0.0:
-            step = rem if rem < GUN_TURN_RATE else GUN_TURN_RATE
-        else:
-            step = rem if rem > -GUN_TURN_RATE else -GUN_TURN_RATE
+        step = _turn_step(rem, GUN_TURN_RATE)
         rf[b, GH, i] += step
         rf[b, RH, i] += step
         if rb[b, ADJRG, i]:
@@ -408,10 +409,7 @@ def _turn_radar(rf, b, i):
     """RobotPeer.updateRadarHeading: at most 45 deg."""
     rem = rf[b, RADREM, i]
     if rem != 0.0:
-        if rem > 0.0:
-            step = rem if rem < RADAR_TURN_RATE else RADAR_TURN_RATE
-        else:
-            step = rem if rem > -RADAR_TURN_RATE else -RADAR_TURN_RATE
+        step = _turn_step(rem, RADAR_TURN_RATE)
         rf[b, RH, i] += step
         rf[b, RADREM, i] = 0.0 if step == rem else rem - step
     rf[b, RH, i] = normal_absolute_angle(rf[b, RH, i])

@@ -71,11 +71,28 @@ def test_script_validation() -> None:
         ScriptedRobot(1, 1, 0, ((0, "ahead", 1.0),))
 
 
+def _without_cpu_constant(text: str) -> list[object]:
+    lines = [json.loads(ln) for ln in text.splitlines()]
+    lines[0].pop("cpu_constant_ms")
+    return lines
+
+
 @pytest.mark.engine
 @pytest.mark.parametrize("name", ["straight_and_brake", "bullet_hits_bullet"])
 def test_rerecording_gives_identical_trace(install, tmp_path, name: str) -> None:
+    """The engine replays a script exactly, given its robot threads keep up.
+
+    Robocode waits at most the CPU constant for a robot each turn; on a starved machine a late robot's
+    stale commands can act one turn late without a skipped-turn report. So the re-recording uses a
+    generous constant (the engine waits only as long as the robot needs) and gets one retry.
+    """
     battle = next(b for b in BATTLES if b.name == name)
+    want = _without_cpu_constant((TRACES / f"{name}.jsonl").read_text())
     out = tmp_path / f"{name}.jsonl"
-    facts = record(battle, out)
+    for _attempt in range(2):
+        facts = record(battle, out, cpu_constant_ms=200.0)
+        got = _without_cpu_constant(out.read_text())
+        if facts["skipped"] == {} and got == want:
+            break
     assert facts["skipped"] == {}
-    assert out.read_text() == (TRACES / f"{name}.jsonl").read_text()
+    assert got == want

@@ -1,10 +1,11 @@
 """The learning tanks' fixed gun/radar controller and the paper's four macro moves (paper 6.1).
 
-Vectorised over ``(B, R)``. The target of each robot is its nearest living enemy (true state; the
-controller's radar keeps that robot scanned, so reading its true position matches what a Robocode
-robot would know). Per turn the controller turns the radar toward the target with an overshoot
-(a classic lock), turns the gun toward it, and fires when the gun points at the target within
-``aim_tolerance`` with a power chosen from the distance.
+Vectorised over ``(B, R)``. Each robot aims at the target it knows: with a scan ``memory`` (see
+:mod:`confront.arena.observe`, ``sensing``) its nearest enemy among those it has scanned this round, at
+that enemy's last scanned position, exactly as the exported PolicyBot does; without one the true
+state. Per turn the controller turns the radar toward the target with an overshoot (a classic lock),
+turns the gun toward it, and fires when the gun points at the target within ``aim_tolerance`` with a
+power chosen from the distance. With no known target the radar spins and the gun keeps its command.
 
 Moves (action ids): 0 forward, 1 backward, 2 clockwise, 3 anticlockwise. Each becomes commands
 written once at the start of an SMDP step of T turns; the robot then executes them over the step.
@@ -18,8 +19,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core import Arena
+from .observe import Sensing, TargetRule, perceive, remember_scans, select_targets
 
-__all__ = ["ControlConfig", "nearest_enemy", "move_commands", "gun_radar_commands", "N_MOVES", "MOVE_NAMES"]
+__all__ = ["ControlConfig", "nearest_enemy", "move_commands", "gun_radar_commands", "aim", "remember",
+           "known_targets", "N_MOVES", "MOVE_NAMES"]
 
 MOVE_NAMES = ("forward", "backward", "clockwise", "anticlockwise")
 N_MOVES = 4
@@ -73,26 +76,61 @@ def power_for_distance(dist: np.ndarray, cfg: ControlConfig) -> np.ndarray:
                     np.where(dist < cfg.far_distance, cfg.power_mid, cfg.power_far))
 
 
-def gun_radar_commands(arena: Arena, cmd: np.ndarray, cfg: ControlConfig = ControlConfig(),
-                       target: np.ndarray | None = None, robots: np.ndarray | None = None) -> np.ndarray:
-    """Fill gun turn, radar turn and fire power of ``cmd`` (B, R, 5) in place for ``robots`` (bool (R,))."""
-    s = arena.state
-    tgt = nearest_enemy(arena) if target is None else target
-    has = tgt >= 0
-    t = np.where(has, tgt, 0)
-    tx = np.take_along_axis(s.x, t, axis=1)
-    ty = np.take_along_axis(s.y, t, axis=1)
-    dx, dy = tx - s.x, ty - s.y
+def aim(x: np.ndarray, y: np.ndarray, gun_heading: np.ndarray, radar_heading: np.ndarray,
+        gun_heat: np.ndarray, energy: np.ndarray, tx: np.ndarray, ty: np.ndarray, has: np.ndarray,
+        cfg: ControlConfig = ControlConfig()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(gun turn, radar turn, fire power) toward (tx, ty) where ``has``; elsewhere (NaN = keep, 2 pi, 0).
+
+    Arrays of one shape (or scalars). The rule of PolicyModel.gunRadar and the compiled controller_turn."""
+    dx, dy = tx - x, ty - y
     bearing = np.arctan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise
     dist = np.hypot(dx, dy)
-    gun_turn = _rel(bearing - s.gun_heading)
-    radar_turn = _rel(bearing - s.radar_heading)
-    radar_turn = radar_turn + np.sign(radar_turn) * cfg.radar_overshoot
-    fire = has & (np.abs(gun_turn) <= cfg.aim_tolerance) & (s.gun_heat == 0) & (s.energy > 0) & cfg.fire
+    gun = _rel(bearing - gun_heading)
+    radar = _rel(bearing - radar_heading)
+    radar = radar + np.sign(radar) * cfg.radar_overshoot  # overshoot past the target keeps the radar lock
+    # Robocode fires only with a cold gun and energy left (Rules: gun heat 1 + p/5 after a shot)
+    fire = has & (np.abs(gun) <= cfg.aim_tolerance) & (gun_heat == 0) & (energy > 0) & cfg.fire
+    return (np.where(has, gun, np.nan), np.where(has, radar, 2 * np.pi),
+            np.where(fire, power_for_distance(dist, cfg), 0.0))
+
+
+def remember(memory: np.ndarray, arena: Arena) -> None:
+    """Add this turn's radar scans of ``arena`` to ``memory`` (B, 3, R, R): x, y, energy of each scanned robot."""
+    s = arena.state
+    for b in range(arena.n_battles):
+        remember_scans(s.scanned[b], s.x[b], s.y[b], s.energy[b], memory[b])
+
+
+def known_targets(view: tuple[np.ndarray, ...], team: np.ndarray, rule: TargetRule = "nearest") -> np.ndarray:
+    """(B, R) target of each robot in its own picture ``view`` = (x, y, energy, alive), each (B, R, R)."""
+    vx, vy, ve, va = view
+    b, r = vx.shape[:2]
+    team_b = np.repeat(np.broadcast_to(np.asarray(team), (b, r)), r, axis=0)
+    t = select_targets(*(v.reshape(b * r, r) for v in (vx, vy, ve, va)), team_b, rule)
+    return t.reshape(b, r, r)[:, np.arange(r), np.arange(r)]
+
+
+def gun_radar_commands(arena: Arena, cmd: np.ndarray, cfg: ControlConfig = ControlConfig(),
+                       target: np.ndarray | None = None, robots: np.ndarray | None = None,
+                       memory: np.ndarray | None = None, sensing: Sensing = "scanned",
+                       rule: TargetRule = "nearest") -> np.ndarray:
+    """Fill gun turn, radar turn and fire power of ``cmd`` (B, R, 5) in place for ``robots`` (bool (R,)).
+
+    With ``memory`` (B, 3, R, R, see :func:`remember`) each robot aims at its target (``target``, or by
+    ``rule``) as it knows it (``sensing``); without it, at the true positions (``target`` or the nearest)."""
+    s = arena.state
+    view = perceive(s.x, s.y, s.energy, s.alive, s.team, memory, s.scan_time if memory is not None else None,
+                    sensing if memory is not None else "true")
+    tgt = known_targets(view, s.team, rule) if target is None else target
+    has = tgt >= 0
+    t = np.where(has, tgt, 0)[..., None]
+    tx = np.take_along_axis(view[0], t, axis=2)[..., 0]
+    ty = np.take_along_axis(view[1], t, axis=2)[..., 0]
+    gun, radar, power = aim(s.x, s.y, s.gun_heading, s.radar_heading, s.gun_heat, s.energy, tx, ty, has, cfg)
     sel = s.alive & (np.ones_like(has) if robots is None else robots[None, :])
-    cmd[..., 2] = np.where(sel & has, gun_turn, cmd[..., 2])
-    cmd[..., 3] = np.where(sel, np.where(has, radar_turn, 2 * np.pi), cmd[..., 3])
-    cmd[..., 4] = np.where(sel & fire, power_for_distance(dist, cfg), np.where(sel, 0.0, cmd[..., 4]))
+    cmd[..., 2] = np.where(sel & has, gun, cmd[..., 2])
+    cmd[..., 3] = np.where(sel, radar, cmd[..., 3])
+    cmd[..., 4] = np.where(sel, power, cmd[..., 4])
     return cmd
 
 

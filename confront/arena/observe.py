@@ -19,6 +19,13 @@ target energy / 100`` and, with ``include_position``, ``x / width, y / height``.
 The target is the nearest living enemy by default (``target="nearest"``) or the living enemy with the
 least energy (``target="weakest"``, ties to the nearest). A robot with no living enemy has target -1;
 its relative angle and distance are then 0 and 0 (discrete: ahead, bin 0) and target energy is 0.
+
+Sensing (``sensing="scanned"``, the default): like a Robocode robot (and the exported PolicyBot), each robot
+knows an enemy only from its radar: the position and energy of its last scan this round, forgotten when
+that enemy dies (RobotDeathEvent). Before its first scan of a round a robot knows no enemy (target -1).
+Targets, state, features and the gun/radar controller all use this picture; ``sensing="true"`` reads
+the true state instead. The memory is ``(B, 3, R, R)``: ``memory[b, :, i, j]`` = x, y, energy of robot j
+at robot i's last scan of it, valid where ``seen[b, i, j] >= 0`` (the arena's ``scan_time``).
 """
 
 from __future__ import annotations
@@ -36,6 +43,8 @@ N_STATES = N_REL_BINS * N_HEADING_BINS * N_DIST_BINS  # 320, paper §6.1
 TWO_PI = 2.0 * np.pi
 
 TargetRule = Literal["nearest", "weakest"]
+Sensing = Literal["scanned", "true"]
+SENSING: dict[str, int] = {"true": 0, "scanned": 1}
 
 
 @dataclass(frozen=True)
@@ -46,10 +55,13 @@ class ObservationConfig:
     max_distance: float | None = None  # None = field diagonal
     include_position: bool = False
     reward_guard: float = 1.0  # floor of Eq. 35's denominator
+    sensing: Sensing = "scanned"  # enemies as last scanned (a real robot's knowledge) or their true state
 
     def __post_init__(self) -> None:
         if self.target not in ("nearest", "weakest"):
             raise ValueError(f"observation.target must be 'nearest' or 'weakest', got {self.target!r}")
+        if self.sensing not in SENSING:
+            raise ValueError(f"observation.sensing must be 'scanned' or 'true', got {self.sensing!r}")
         if self.max_distance is not None and not self.max_distance > 0:
             raise ValueError(f"observation.max_distance must be > 0, got {self.max_distance!r}")
         if not self.reward_guard > 0:
@@ -250,6 +262,65 @@ reward_eq35_scalar = njit(cache=True)(reward_eq35)  # the same rule compiled for
 
 
 @njit(cache=True)
+def remember_scans(scanned: np.ndarray, x: np.ndarray, y: np.ndarray, e: np.ndarray, memory: np.ndarray) -> None:
+    """Store, for one battle, what each robot's radar saw this turn: memory[:, i, j] = (x, y, energy) of j
+    where scanned[i, j] (the values of a ScannedRobotEvent: the scan comes after every robot moved)."""
+    n = x.shape[0]
+    for i in range(n):
+        for j in range(n):
+            if scanned[i, j]:
+                memory[0, i, j] = x[j]
+                memory[1, i, j] = y[j]
+                memory[2, i, j] = e[j]
+
+
+@njit(cache=True)
+def perceive_row(x: np.ndarray, y: np.ndarray, e: np.ndarray, alive: np.ndarray, team: np.ndarray, i: int,
+                 memory: np.ndarray, seen: np.ndarray, sensing: int, vx: np.ndarray, vy: np.ndarray,
+                 ve: np.ndarray, va: np.ndarray) -> None:
+    """Robot i's picture of one battle's (R,) robots into vx, vy, ve, va: itself and team-mates as they are;
+    an enemy (sensing 1) at its last scanned position and energy, known while alive and scanned this round
+    (PolicyBot's map of ScannedRobotEvents, emptied each round, entry removed on RobotDeathEvent);
+    with sensing 0 every robot as it is. ``memory`` (3, R, R) and ``seen`` (R, R) are the battle's."""
+    for j in range(x.shape[0]):
+        if sensing == 0 or j == i or team[j] == team[i]:
+            vx[j], vy[j], ve[j], va[j] = x[j], y[j], e[j], alive[j]
+        else:
+            vx[j], vy[j], ve[j] = memory[0, i, j], memory[1, i, j], memory[2, i, j]
+            va[j] = alive[j] and seen[i, j] >= 0
+
+
+@njit(cache=True)
+def _perceive_kernel(x, y, e, alive, team, memory, seen, sensing, vx, vy, ve, va):  # noqa: ANN001 - numba kernel
+    for b in range(x.shape[0]):
+        for i in range(x.shape[1]):
+            perceive_row(x[b], y[b], e[b], alive[b], team[b], i, memory[b], seen[b], sensing,
+                         vx[b, i], vy[b, i], ve[b, i], va[b, i])
+
+
+def perceive(x: np.ndarray, y: np.ndarray, energy: np.ndarray, alive: np.ndarray, team: np.ndarray,
+             memory: np.ndarray | None, seen: np.ndarray | None,
+             sensing: Sensing = "scanned") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y, energy, alive) of every robot as each robot knows it, (B, R, R) each: ``[b, i, j]`` is robot
+    j in robot i's picture (see :func:`perceive_row`). ``memory`` (B, 3, R, R) / ``seen`` (B, R, R) may be
+    None only with ``sensing="true"``."""
+    if sensing not in SENSING:
+        raise ValueError(f"sensing must be 'scanned' or 'true', got {sensing!r}")
+    b, r = x.shape
+    if memory is None or seen is None:
+        if sensing != "true":
+            raise ValueError("sensing='scanned' needs the scan memory and the scan times")
+        memory, seen = np.zeros((b, 3, r, r)), np.zeros((b, r, r), dtype=np.int32)
+    out = tuple(np.empty((b, r, r)) for _ in range(3)) + (np.empty((b, r, r), dtype=np.bool_),)
+    team_b = np.ascontiguousarray(np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape))
+    _perceive_kernel(np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64),
+                     np.ascontiguousarray(energy, dtype=np.float64), np.ascontiguousarray(alive, dtype=np.bool_),
+                     team_b, np.ascontiguousarray(memory, dtype=np.float64), np.ascontiguousarray(seen),
+                     SENSING[sensing], *out)
+    return out  # type: ignore[return-value]
+
+
+@njit(cache=True)
 def robot_observation(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray, i: int, tgt: int,
                       max_distance: float, width: float, height: float, feat: np.ndarray) -> int:
     """Discrete state of robot i toward robot tgt (-1: none) from (R,) rows; writes its features in ``feat``
@@ -278,15 +349,20 @@ def robot_observation(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray
 
 @njit(cache=True)
 def observe_kernel(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray, alive: np.ndarray,
-                   team: np.ndarray, rule: int, max_distance: float, width: float, height: float,
+                   team: np.ndarray, memory: np.ndarray, seen: np.ndarray, sensing: int, rule: int,
+                   max_distance: float, width: float, height: float,
                    target: np.ndarray, disc: np.ndarray, feats: np.ndarray) -> None:
-    """Targets, discrete states and features of every robot of (B, R) arrays, into the outputs."""
+    """Targets, discrete states and features of every robot of (B, R) arrays, each from its own picture
+    (:func:`perceive_row`), into the outputs."""
+    n = x.shape[1]
     row = np.zeros(feats.shape[2])
+    vx, vy, ve, va = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
     for b in range(x.shape[0]):
-        for i in range(x.shape[1]):
-            tg = target_of(x[b], y[b], e[b], alive[b], team[b], i, rule)
+        for i in range(n):
+            perceive_row(x[b], y[b], e[b], alive[b], team[b], i, memory[b], seen[b], sensing, vx, vy, ve, va)
+            tg = target_of(vx, vy, ve, va, team[b], i, rule)
             target[b, i] = tg
-            disc[b, i] = robot_observation(x[b], y[b], h[b], e[b], i, tg, max_distance, width, height, row)
+            disc[b, i] = robot_observation(vx, vy, h[b], ve, i, tg, max_distance, width, height, row)
             for k in range(row.shape[0]):
                 feats[b, i, k] = row[k]
 
@@ -300,13 +376,22 @@ def observe(
     team: np.ndarray,
     field: tuple[float, float],
     config: ObservationConfig,
+    memory: np.ndarray | None = None,
+    seen: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(target (B, R), discrete state (B, R), features (B, R, F)) for every robot (compiled)."""
+    """(target (B, R), discrete state (B, R), features (B, R, F)) for every robot (compiled).
+
+    With the scan ``memory`` (B, 3, R, R) and ``seen`` (B, R, R) times, each robot sees enemies as
+    ``config.sensing`` says; without them every robot sees the true state."""
     dmax = config.max_distance or field_diagonal(*field)
+    b, r = x.shape
     target = np.empty(x.shape, dtype=np.int64)
     disc = np.empty(x.shape, dtype=np.int64)
     feats = np.empty(x.shape + (config.n_features,), dtype=np.float32)
     team_b = np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape)
-    observe_kernel(x, y, heading, energy, alive, team_b, TARGET_RULES[config.target], float(dmax),
-                   float(field[0]), float(field[1]), target, disc, feats)
+    sensing = SENSING[config.sensing] if memory is not None and seen is not None else 0
+    if memory is None or seen is None:
+        memory, seen = np.zeros((b, 3, r, r)), np.zeros((b, r, r), dtype=np.int32)
+    observe_kernel(x, y, heading, energy, alive, team_b, memory, seen, sensing, TARGET_RULES[config.target],
+                   float(dmax), float(field[0]), float(field[1]), target, disc, feats)
     return target, disc, feats

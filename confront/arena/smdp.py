@@ -22,6 +22,13 @@ the observations; with 8+ battles and several numba threads, battle ranges run o
 Observations equal :func:`confront.arena.observe.observe`'s; the controller equals
 :func:`confront.arena.control.gun_radar_commands` (tested).
 
+What a robot knows (``observation.sensing``, default ``"scanned"``): the env keeps, per robot, each
+enemy's position and energy at its last radar scan this round (``memory`` (B, 3, R, R), filled from the
+arena's scan events after every turn; known while the enemy lives and ``scan_time`` >= 0). Targets, the
+state, the features, the rewards' target and the gun/radar controller all use it, as the exported
+PolicyBot does in the real engine. So a round's first decision (turn 1, before any scan) sees no target,
+in both.
+
 Default T = 10 turns: the paper gives no value; a 45-degree turn takes 5 turns at rest and a
 100 px move about 16, so 10 turns lets each macro move show its effect while keeping decisions frequent.
 """
@@ -43,12 +50,15 @@ from .bots import BOT_NAMES, ScriptedBots, bots_step
 from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
 from .core import Arena
 from .observe import (
+    SENSING,
     TARGET_RULES,
     ObservationConfig,
     field_diagonal,
     float_mod,
     observe,
     observe_kernel,
+    perceive_row,
+    remember_scans,
     reward_eq35_scalar,
     target_of,
 )
@@ -169,6 +179,8 @@ class TeamBattleEnv:
         self._move = np.zeros((b, r, 2))
         self._move_table = np.stack(move_commands(np.arange(N_MOVES), self.config.control), axis=-1)
         self._power = np.zeros((b, r))
+        self._memory = np.zeros((b, 3, r, r))  # x, y, energy of each robot at each robot's last scan of it
+        self._sensing = SENSING[self.config.observation.sensing]
         self._turn_buf = np.zeros((4, b, r))  # per turn: target, own energy, target energy, live
         self._kinds = self.bots.kinds.astype(np.int64) if self.bots is not None else np.zeros(r, np.int64)
         self._rule = TARGET_RULES[self.config.observation.target]
@@ -218,7 +230,8 @@ class TeamBattleEnv:
     def observe(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(target, discrete, features) of the current state for every robot."""
         s = self.arena.state
-        return observe(s.x, s.y, s.heading, s.energy, s.alive, self.team, self.field, self.config.observation)
+        return observe(s.x, s.y, s.heading, s.energy, s.alive, self.team, self.field, self.config.observation,
+                       self._memory, s.scan_time)
 
     def reset(self, seed: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Start new battles (totals cleared; reseeded when ``seed`` is given): (discrete, features)."""
@@ -303,7 +316,8 @@ class TeamBattleEnv:
         """Turns t0..t1-1 of the SMDP step in the compiled kernel (then observations into ``obs``);
         battle ranges run in parallel threads when there are enough battles."""
         head = (t0, t1, self.learner, self._kinds, self.bots is not None, self._rule,
-                self.config.observation.reward_guard, self._move, self._power, self._ctrl)
+                self.config.observation.reward_guard, self._move, self._power, self._ctrl, self._memory,
+                self._sensing)
         tail = (rewards, self.max_distance, *obs)
         if len(self._ranges) == 1:
             return _smdp_turns(0, self.n_battles, *head, *self._kargs, self._rems[0], *self._kargs_end, *tail)
@@ -333,8 +347,9 @@ class TeamBattleEnv:
 
     # ------------------------------------------------------------------ checkpoints
     def state_dict(self) -> dict[str, np.ndarray]:
-        """Arena arrays plus the scripted bots' memory (data only)."""
+        """Arena arrays, the robots' scan memory and the scripted bots' memory (data only)."""
         d = {f"arena.{k}": v for k, v in self.arena.state_dict().items()}
+        d["control.memory"] = self._memory.copy()
         if self.bots is not None:
             d.update({f"bots.{k}": v for k, v in self.bots.state_dict().items()})
         return d
@@ -342,6 +357,11 @@ class TeamBattleEnv:
     def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
         """Restore what :meth:`state_dict` wrote."""
         self.arena.load_state_dict({k[6:]: v for k, v in d.items() if k.startswith("arena.")})
+        if "control.memory" not in d:
+            raise ValueError("state dict lacks 'control.memory' (saved before the scan memory existed)")
+        if d["control.memory"].shape != self._memory.shape:
+            raise ValueError(f"control.memory has shape {d['control.memory'].shape}, expected {self._memory.shape}")
+        self._memory[...] = d["control.memory"]
         if self.bots is not None:
             self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
         self._last = self.observe()
@@ -420,9 +440,10 @@ def _relative(a: float) -> float:
 
 
 @njit(cache=True)
-def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, ctrl: np.ndarray, power: float,
-                    cmd: np.ndarray) -> None:
-    """Gun turn, radar turn and fire power of a living learning tank (control.gun_radar_commands' rule).
+def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: float, ctrl: np.ndarray,
+                    power: float, cmd: np.ndarray) -> None:
+    """Gun turn, radar turn and fire power of a living learning tank (control.aim's rule) toward its
+    target ``tgt`` known at (tx, ty).
 
     The radar turns to the target plus an overshoot, the gun to the target; the tank fires when the gun
     is within the tolerance, the gun is cold and it has energy; power by distance band, or ``power`` > 0.
@@ -432,8 +453,8 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, ctrl: np.ndarray, 
         cmd[b, i, 3] = 2 * np.pi
         cmd[b, i, 4] = 0.0
         return
-    dx = rf[b, K.X, tgt] - rf[b, K.X, i]
-    dy = rf[b, K.Y, tgt] - rf[b, K.Y, i]
+    dx = tx - rf[b, K.X, i]
+    dy = ty - rf[b, K.Y, i]
     bearing = np.arctan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise
     dist = np.hypot(dx, dy)
     gun_turn = _relative(bearing - rf[b, K.GH, i])
@@ -455,7 +476,7 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, ctrl: np.ndarray, 
 
 
 @njit(cache=True, nogil=True)
-def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, ctrl,
+def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, ctrl, memory, sensing,
                 rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
                 placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
                 rewards, max_distance, target, disc, feats):
@@ -463,8 +484,10 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     t = 0, then kept; gun/radar controller every turn), scripted bots, one Robocode turn, Eq. 35 rewards.
     Then the observations of those battles' robots into target, disc, feats. Returns the turn index where
     it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can run
-    in parallel threads."""
+    in parallel threads. Each robot picks its target and aims from its own picture (observe.perceive_row);
+    after each turn the robots' scans go into ``memory``."""
     n = rf.shape[2]
+    vx, vy, ve, va = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
     for t in range(t0, t1):
         any_live = False
         for b in range(b0, b1):
@@ -473,7 +496,9 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 continue
             any_live = True
             for i in range(n):
-                tg = target_of(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, rule)
+                perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
+                             scan_time[b], sensing, vx, vy, ve, va)
+                tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
                 buf[0, b, i] = tg
                 buf[1, b, i] = rf[b, K.E, i]
                 buf[2, b, i] = rf[b, K.E, tg] if tg >= 0 else 0.0
@@ -486,7 +511,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     cmd[b, i, 3] = np.nan
                     cmd[b, i, 4] = 0.0
                     if rb[b, K.ALIVE, i]:
-                        controller_turn(rf, b, i, tg, ctrl, power[b, i], cmd)
+                        controller_turn(rf, b, i, tg, vx[tg] if tg >= 0 else 0.0, vy[tg] if tg >= 0 else 0.0,
+                                        ctrl, power[b, i], cmd)
                 else:
                     for c in range(4):
                         cmd[b, i, c] = np.nan
@@ -505,12 +531,13 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
         K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                      placements, placements_total, cmd, params, scratch_i, scratch_f)
         for b in range(b0, b1):
+            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], memory[b])
             for i in range(n):
                 if buf[3, b, i] > 0:
                     tg = int(buf[0, b, i])
                     rewards[b, i, t] = reward_eq35_scalar(buf[1, b, i], rf[b, K.E, i], buf[2, b, i],
                                                           rf[b, K.E, tg], guard)
     r = slice(b0, b1)
-    observe_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.E], rb[r, K.ALIVE], ri[r, K.TEAM], rule,
-                   max_distance, width, height, target[r], disc[r], feats[r])
+    observe_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.E], rb[r, K.ALIVE], ri[r, K.TEAM], memory[r],
+                   scan_time[r], sensing, rule, max_distance, width, height, target[r], disc[r], feats[r])
     return t1

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from confront.arena.control import ControlConfig
+from confront.arena.control import ControlConfig, aim
 from confront.arena.observe import (
     N_STATES,
     ObservationConfig,
@@ -33,11 +33,6 @@ from confront.engine.java_build import compile_java
 
 ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
 POLICY_CLASSES = ("PolicyBot", "PolicyModel", "RoundStart")
-
-
-def _rel(a: float) -> float:
-    """Angle in [-pi, pi) as (a + pi) mod 2pi - pi (confront.arena.control)."""
-    return (a + math.pi) % (2 * math.pi) - math.pi
 
 
 @dataclass(frozen=True)
@@ -171,22 +166,16 @@ class ExportedPolicy:
         return int(np.argmax(self.values(obs)))
 
     def gun_radar(self, obs: Observation) -> tuple[float, float, float]:
-        """(gun turn, radar turn, fire power) of the fixed controller toward the nearest known enemy."""
-        c = self.control
+        """(gun turn, radar turn, fire power) of the fixed controller (``confront.arena.control.aim``) toward
+        the nearest enemy at its last scanned position."""
         es = obs.enemies()
         if not es:
             return (math.nan, 2 * math.pi, 0.0)
         d2 = [(s.x - obs.x) ** 2 + (s.y - obs.y) ** 2 for s in es]
         t = es[int(np.argmin(d2))]
-        dx, dy = t.x - obs.x, t.y - obs.y
-        bearing = math.atan2(dx, dy)
-        dist = math.hypot(dx, dy)
-        gun = _rel(bearing - obs.gun_heading)
-        radar = _rel(bearing - obs.radar_heading)
-        radar += math.copysign(c.radar_overshoot, radar) if radar != 0 else 0.0
-        fire = abs(gun) <= c.aim_tolerance and obs.gun_heat == 0 and obs.energy > 0 and c.fire
-        power = c.power_near if dist < c.near_distance else c.power_mid if dist < c.far_distance else c.power_far
-        return (gun, radar, power if fire else 0.0)
+        gun, radar, power = aim(np.float64(obs.x), np.float64(obs.y), obs.gun_heading, obs.radar_heading,
+                                obs.gun_heat, obs.energy, t.x, t.y, np.True_, self.control)
+        return (float(gun), float(radar), float(power))
 
     def __call__(self, obs: Observation) -> tuple[float, float, float, float, float]:
         """Bridge policy with the exported robot's timing: a move every ``step_turns`` turns."""

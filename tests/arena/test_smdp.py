@@ -25,10 +25,14 @@ def test_rewards_per_turn_hand_computed() -> None:
     r1 = env.step(np.array([[2, 0]]))
     assert r1.rewards.shape == (1, 2, 40)
     assert np.all(r1.rewards[0, 0] == 0.0)
-    # every robot gets its Eq. 35 reward (learners are marked by ``active``): the duck sees the learner
-    # pay 2 for its turn-31 shot at equal energies: (0 + 2) * 2 / max(|100 - 100|, 1) = 4 (the guard)
-    assert np.flatnonzero(r1.rewards[0, 1]).tolist() == [30]
-    assert r1.rewards[0, 1, 30] == 4.0
+    # the learner's radar found the duck in turn 1 (it spins from 90 deg, the duck lies on the sweep's
+    # start line) and then points exactly at it (no overshoot at a zero turn); after the 45-degree body
+    # turn (5 turns) nothing moves, so nothing is scanned (Robocode scans only when something turned or
+    # moved). The memory keeps the duck: it stays the target.
+    assert env.arena.state.scan_time[0, 0, 1] == 5
+    # a SittingDuck never turns its radar, so it never scans: it knows no target and earns no Eq. 35 reward
+    assert env.arena.state.scan_time[0, 1, 0] == -1
+    assert np.all(r1.rewards[0, 1] == 0.0) and r1.target[0].tolist() == [1, -1]
     assert env.arena.state.energy[0].tolist() == [98.0, 100.0]
     r2 = env.step(np.array([[2, 0]]))
     nz = np.flatnonzero(r2.rewards[0, 0])
@@ -128,25 +132,31 @@ def test_bad_input_errors() -> None:
 def test_compiled_controller_matches_control_module() -> None:
     from confront.arena import _kernels as K
     from confront.arena.control import ControlConfig, gun_radar_commands
+    from confront.arena.observe import perceive
     from confront.arena.smdp import controller_turn
 
     env = TeamBattleEnv("4v4", n_battles=4, seed=8, opponents="td")
     env.reset()
     for a in np.random.default_rng(2).integers(0, 4, size=(25, 4, 8)):
-        env.step(a)  # a mix of positions, headings, gun heat and energies
+        env.step(a)  # a mix of positions, headings, gun heat, energies and stale scans
     s = env.arena.state
     s.gun_heat[:, ::2] = 0.0
     tgt = env.observe()[0]
     cfg = ControlConfig()
-    ref = gun_radar_commands(env.arena, env.arena.idle_commands(), cfg, target=tgt)
+    ref = gun_radar_commands(env.arena, env.arena.idle_commands(), cfg, memory=env._memory)
+    vx, vy, _, _ = perceive(s.x, s.y, s.energy, s.alive, s.team, env._memory, s.scan_time)
     out = env.arena.idle_commands()
     rf = env.arena.state.packed["rf"]
+    stale = 0
     for b in range(4):
         for i in range(8):
+            t = int(tgt[b, i])
             if s.alive[b, i]:
-                controller_turn(rf, b, i, int(tgt[b, i]), env._ctrl, 0.0, out)
+                controller_turn(rf, b, i, t, vx[b, i, t], vy[b, i, t], env._ctrl, 0.0, out)
+                stale += t >= 0 and (vx[b, i, t], vy[b, i, t]) != (s.x[b, t], s.y[b, t])
     # equal up to the last bit of arctan2 (NumPy's and LLVM's libm may differ by one ulp)
     np.testing.assert_allclose(out[..., :4], ref[..., :4], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(out[..., 4], ref[..., 4])
     assert (ref[..., 4] > 0).any()  # some tanks fire
+    assert stale > 0  # some tanks aim at a stale scan, not at the true position
     assert K.X == 0  # the kernel reads the packed arrays by these positions

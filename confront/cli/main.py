@@ -70,20 +70,21 @@ def demo(out: Path | None, rounds: int | None, seed: int | None, overrides: tupl
               help="Continue the run in this folder from its latest checkpoint.")
 @click.option("--seed", type=int, default=None)
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True,
-              help="Train in the simulator or live in the real Robocode engine (no --resume there).")
+              help="Train in the simulator or live in the real Robocode engine (checkpointed per battle).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @set_option
 def train(config: str, out: Path | None, resume: Path | None, seed: int | None, engine: str, quiet: bool,
           overrides: tuple[str, ...]) -> None:
-    """Train one arm of an experiment (simulator: resumable with --resume)."""
+    """Train one arm of an experiment; --resume RUN continues a killed run from its latest checkpoint."""
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import print_summary, train_run
 
     if engine == "robocode":
-        if resume is not None:
-            raise click.UsageError("--resume is not available with --engine robocode (no engine checkpoints)")
         from confront.experiments.train_engine import train_in_engine
 
+        if resume is not None:
+            print_summary(train_in_engine(None, resume, progress=not quiet, resume=True))
+            return
         extra = (f"train.seed={seed}",) if seed is not None else ()
         print_summary(train_in_engine(load_experiment(config, overrides + extra), out, progress=not quiet))
         return

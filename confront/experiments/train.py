@@ -361,6 +361,8 @@ def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool
         latest = ck.latest(run.checkpoints)
         if latest is not None:
             arrays, meta = ck.load(latest)
+            if meta.get("engine") == "robocode":
+                raise ck.CheckpointError(f"{latest} was trained in the real engine: resume it with --engine robocode")
             loop.load(arrays, meta)
             elapsed_before = float(meta.get("elapsed_s", 0.0))
             if progress:

@@ -7,7 +7,13 @@ plots/, summary.json (same keys, plus the engine's skipped turns and bridge fail
 and results.csv (the engine's results for the whole battle). Per-round score parts come from the runner's
 ``round_scores`` (each robot's battle totals at each round's end, differenced).
 Curriculum transfer wraps the learner in ``TransferPolicy`` (Eq. 34) as the simulator does. The TD team plays
-its frozen table (``opponent.learning`` is ignored). No checkpoints: an interrupted engine run starts again.
+its frozen table (``opponent.learning`` is ignored).
+
+Checkpoints: the rounds are played as a sequence of battles of ``train.checkpoint_every`` rounds (battle k has
+engine seed ``train.seed + k``); after each battle the learner, the policy's RNG, counters and the rows so far
+are checkpointed, so ``confront train --resume RUN --engine robocode`` continues after a kill at the next battle.
+The engine's robot threads make a battle's course depend on timing, so a resumed engine run is not identical to
+an uninterrupted one (the simulator's runs are); it loses at most the battle that was running.
 """
 
 from __future__ import annotations
@@ -20,10 +26,11 @@ from typing import Any
 
 import numpy as np
 
+from confront import checkpoint as ck
 from confront.arena.observe import ObservationConfig
 from confront.arena.state import SCORE_PARTS
 from confront.checkpoint import CheckpointError
-from confront.config import to_dict
+from confront.config import load_toml, to_dict
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
 from confront.engine.bridge import Action, Observation
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
@@ -31,7 +38,7 @@ from confront.engine.evaluate import _single_star
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
-from confront.experiments.spec import ExperimentConfig
+from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.experiments.train import (
     _plots,
     build_learner,
@@ -142,67 +149,138 @@ def _transfer(cfg: ExperimentConfig, learner: Learner) -> tuple[Learner, dict[st
 
 
 class _Progress:
-    """Bridge policy wrapper that advances a progress bar as rounds end."""
+    """Bridge policy wrapper that advances a progress bar as rounds end (``done`` rounds before this battle)."""
 
-    def __init__(self, policy: LearnerPolicy, rounds: int, desc: str, show: bool) -> None:
-        from tqdm import tqdm
-
-        self.policy = policy
-        self.bar = tqdm(total=rounds, desc=desc, unit="round", disable=not show, dynamic_ncols=True)
-        self.seen = -1
+    def __init__(self, policy: LearnerPolicy, bar: Any, done: int) -> None:
+        self.policy, self.bar, self.done = policy, bar, done
 
     def __call__(self, obs: Observation) -> Action:
-        if obs.round > self.seen:
-            self.bar.update(max(0, obs.round - max(self.seen, 0)))
-            self.seen = obs.round
+        if self.done + obs.round > self.bar.n:
+            self.bar.update(self.done + obs.round - self.bar.n)
         return self.policy(obs)
 
     def end_episode(self, robot: str, round_: int) -> None:
         self.policy.end_episode(robot, round_)
 
 
-def _battle(cfg: ExperimentConfig, opponent: str) -> BattleSpec:
-    spec = scenario_battle(cfg.arena.scenario, BRIDGE_BOT.rstrip("*"), opponent, rounds=cfg.train.rounds)
+def _battle(cfg: ExperimentConfig, opponent: str, rounds: int) -> BattleSpec:
+    spec = scenario_battle(cfg.arena.scenario, BRIDGE_BOT.rstrip("*"), opponent, rounds=rounds)
     return _single_star(_single_star(spec, BRIDGE_BOT), POLICY_BOT)
 
 
+def _end_battle(policy: LearnerPolicy) -> None:
+    """Learn every step still open when a battle ends as terminal (rounds restart at 0 in the next battle)."""
+    for robot, round_ in list(policy._pending):
+        policy.end_episode(robot, round_)
+
+
+def _checkpoint(run: Run, learner: Learner, policy: LearnerPolicy, state: dict[str, Any]) -> None:
+    arrays = {f"learner.{k}": v for k, v in learner.state_dict().items()}
+    meta = {**state, "engine": "robocode", "rng": ck.rng_state(policy.rng), "decisions": policy.decisions,
+            "updates": policy.updates}
+    ck.save(run.checkpoints, f"round-{state['rounds_done']:06d}", arrays, meta)
+
+
+def _restore(run: Run, learner: Learner, policy: LearnerPolicy) -> dict[str, Any]:
+    latest = ck.latest(run.checkpoints)
+    if latest is None:
+        return {}
+    arrays, meta = ck.load(latest)
+    if meta.get("engine") != "robocode":
+        raise CheckpointError(f"{latest} is a simulator checkpoint: resume it without --engine robocode")
+    try:
+        learner.load_state_dict({k[len("learner."):]: v for k, v in arrays.items() if k.startswith("learner.")})
+        policy.rng = ck.rng_from_state(meta["rng"])
+        policy.decisions, policy.updates = int(meta["decisions"]), int(meta["updates"])
+        return {k: meta[k] for k in ("rounds_done", "battles", "rows", "skipped_turns", "bridge_failures",
+                                     "bridge_errors", "rtt_sum_us", "rtt_battles", "setup_s", "elapsed_s")}
+    except (KeyError, ValueError, TypeError) as exc:
+        raise CheckpointError(f"checkpoint {latest} does not fit this run's config: {exc}") from None
+
+
 def train_in_engine(
-    cfg: ExperimentConfig,
+    cfg: ExperimentConfig | None,
     out: str | Path | None,
     progress: bool = True,
     cpu_constant_ms: float = BRIDGE_CPU_CONSTANT_MS,
     exist_ok: bool = False,
+    resume: bool = False,
 ) -> dict[str, Any]:
     """Train ``cfg``'s learner for ``train.rounds`` rounds in the real engine into the run folder ``out``
-    (default ``runs/<name>-<time>``, as the simulator's ``train_run``).
+    (default ``runs/<name>-<time>``, as the simulator's ``train_run``); ``resume`` continues the run in ``out``
+    from its latest checkpoint (``cfg`` is then read from the run folder).
 
-    Returns the summary (train_run's keys plus ``engine``, ``skipped_turns``, ``bridge_failures``,
+    Returns the summary (train_run's keys plus ``engine``, ``battles``, ``skipped_turns``, ``bridge_failures``,
     ``bridge_errors``, ``updates``, ``rtt_mean_us``, ``cpu_constant_ms``). Bad config values raise ValueError.
     """
-    _check(cfg)
     start = time.time()
+    if resume:
+        if out is None:
+            raise ValueError("resume needs the run folder")
+        run = Run(Path(out))
+        if not (run.path / "config.toml").exists():
+            raise FileNotFoundError(f"{run.path} is not a run folder (no config.toml)")
+        cfg = config_from_dict(load_toml(run.path / "config.toml"))
+    elif cfg is None:
+        raise ValueError("train_in_engine needs a config unless resuming")
+    _check(cfg)
     obs_cfg = ObservationConfig(target=cfg.arena.target)
     learner = build_learner(cfg, obs_cfg.n_features, N_MOVES)
     acting, transfer_info = _transfer(cfg, learner)
-    run = Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
-                     exist_ok=exist_ok)
+    if not resume:
+        run = Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
+                         exist_ok=exist_ok)
     policy = LearnerPolicy(acting, np.random.default_rng([cfg.train.seed, 0]), train=True, explore=True,
                            observation=obs_cfg, step_turns=cfg.arena.decision_turns)
-    # a long training battle gets time: 10 s per round on top of the default limit
-    opts = EngineOptions(seed=cfg.train.seed, cpu_constant_ms=cpu_constant_ms)
-    opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * cfg.train.rounds)
-    with tempfile.TemporaryDirectory(prefix="confront-train-") as tmp:
-        opponent, extra, info = _opponent(cfg, obs_cfg, Path(tmp) / "robots", progress)
-        wrapped = _Progress(policy, cfg.train.rounds, f"{cfg.name} {cfg.arena.scenario} (robocode)", progress)
-        try:
-            res: BridgedRun = run_bridged_battle(_battle(cfg, opponent), wrapped, opts, extra_robots=extra)
-            wrapped.bar.update(cfg.train.rounds - wrapped.bar.n)  # the last round has ended too
-        finally:
-            wrapped.bar.close()
-    rows = round_rows(res.run.summary["round_scores"])
+    state: dict[str, Any] = {"rounds_done": 0, "battles": 0, "rows": [], "skipped_turns": 0, "bridge_failures": [],
+                             "bridge_errors": [], "rtt_sum_us": 0.0, "rtt_battles": 0, "setup_s": 0.0,
+                             "elapsed_s": 0.0}
+    if resume:
+        state.update(_restore(run, acting, policy))
+    elapsed_before = float(state["elapsed_s"])
+    total, chunk = cfg.train.rounds, cfg.train.checkpoint_every
     (run.path / "engine").mkdir(exist_ok=True)
-    (run.path / "engine" / "results.txt").write_text(res.run.results_text)  # the engine's own results file
-    (run.path / "engine" / "results.csv").write_text(res.run.results.to_csv())
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, initial=state["rounds_done"], desc=f"{cfg.name} {cfg.arena.scenario} (robocode)",
+               unit="round", disable=not progress, dynamic_ncols=True)
+    try:
+        with tempfile.TemporaryDirectory(prefix="confront-train-") as tmp:
+            opponent, extra, info = _opponent(cfg, obs_cfg, Path(tmp) / "robots", progress)
+            while state["rounds_done"] < total:
+                rounds = min(chunk, total - state["rounds_done"])
+                # a training battle gets time: 10 s per round on top of the default limit
+                opts = EngineOptions(seed=cfg.train.seed + state["battles"], cpu_constant_ms=cpu_constant_ms)
+                opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * rounds)
+                res: BridgedRun = run_bridged_battle(_battle(cfg, opponent, rounds),
+                                                     _Progress(policy, bar, state["rounds_done"]), opts,
+                                                     extra_robots=extra)
+                _end_battle(policy)
+                rows = round_rows(res.run.summary["round_scores"])
+                for r in rows:
+                    r["battle"], r["round"] = state["battles"], r["round"] + state["rounds_done"]
+                folder = run.path / "engine" / f"battle-{state['battles']:03d}"
+                folder.mkdir(exist_ok=True)
+                (folder / "results.txt").write_text(res.run.results_text)  # the engine's own results file
+                (folder / "results.csv").write_text(res.run.results.to_csv())
+                state["rows"] += rows
+                state["rounds_done"] += rounds
+                state["battles"] += 1
+                state["skipped_turns"] += sum(res.run.skipped_turns.values())
+                state["bridge_failures"] += list(res.failures)
+                state["bridge_errors"] += list(res.server_errors)
+                if not np.isnan(res.rtt_mean_us):
+                    state["rtt_sum_us"] += res.rtt_mean_us
+                    state["rtt_battles"] += 1
+                state["setup_s"] += res.run.setup_s
+                state["elapsed_s"] = elapsed_before + time.time() - start
+                bar.update(state["rounds_done"] - bar.n)
+                run.write_table("rounds", state["rows"])
+                if state["rounds_done"] < total:
+                    _checkpoint(run, acting, policy, state)
+    finally:
+        bar.close()
+    rows = state["rows"]
     sessions = session_rows(rows, cfg.train.session_rounds)
     run.write_table("rounds", rows)
     run.write_table("sessions", sessions)
@@ -218,13 +296,14 @@ def train_in_engine(
         "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
         "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
         "score_ours": sum(r["score_ours"] for r in rows), "score_theirs": sum(r["score_theirs"] for r in rows),
-        "learner": acting.diagnostics(), "wall_time_s": time.time() - start,
+        "learner": acting.diagnostics(), "wall_time_s": elapsed_before + time.time() - start,
         "figures": [str(f) for f in figures], "replay": None,
         "n_actions": N_MOVES, "n_features": obs_cfg.n_features, **info, **transfer_info,
-        "engine": "robocode", "cpu_constant_ms": cpu_constant_ms, "updates": policy.updates,
-        "skipped_turns": sum(res.run.skipped_turns.values()), "bridge_failures": list(res.failures),
-        "bridge_errors": list(res.server_errors), "rtt_mean_us": None if np.isnan(res.rtt_mean_us) else res.rtt_mean_us,
-        "engine_setup_s": res.run.setup_s,
+        "engine": "robocode", "battles": state["battles"], "cpu_constant_ms": cpu_constant_ms,
+        "updates": policy.updates, "skipped_turns": state["skipped_turns"],
+        "bridge_failures": state["bridge_failures"], "bridge_errors": state["bridge_errors"],
+        "rtt_mean_us": state["rtt_sum_us"] / state["rtt_battles"] if state["rtt_battles"] else None,
+        "engine_setup_s": state["setup_s"],
     }
     run.write_summary(summary)
     return summary

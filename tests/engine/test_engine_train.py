@@ -10,8 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from confront import checkpoint as ck
+from confront.checkpoint import CheckpointError
+from confront.experiments import train_engine
 from confront.experiments.spec import load_experiment
-from confront.experiments.train import load_model, save_model, td_learner
+from confront.experiments.train import load_model, save_model, td_learner, train_run
 from confront.experiments.train_engine import ENGINE_PARTS, round_rows, train_in_engine
 from confront.learning.tabular import TabularParams, TabularQ
 from confront.results import parse_results_text
@@ -70,31 +73,54 @@ def test_bad_config_is_refused_before_anything_runs(tmp_path: Path, override: st
 
 
 @pytest.mark.engine
-def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path) -> None:
+def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     rounds = 3
     cfg = load_experiment("demo", ["arena.scenario=1v1", "opponent.kind=SittingDuck", "learner.kind=ssaq",
                                    f"train.rounds={rounds}", "train.session_rounds=1", "arena.decision_turns=4",
-                                   "train.seed=3"])
+                                   "train.seed=3", "train.checkpoint_every=2"])
     out = tmp_path / "run"
-    summary = train_in_engine(cfg, out, progress=False)
+    # the run is interrupted while its second battle starts: the first battle's checkpoint survives
+    real, calls = train_engine.run_bridged_battle, []
+
+    def interrupted(*args: object, **kwargs: object) -> object:
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(train_engine, "run_bridged_battle", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        train_in_engine(cfg, out, progress=False)
+    monkeypatch.setattr(train_engine, "run_bridged_battle", real)
+    with open(out / "metrics" / "rounds.csv") as f:
+        first = list(csv.DictReader(f))
+    assert [int(r["round"]) for r in first] == [1, 2] and not (out / "summary.json").exists()
+    _, meta = ck.load(ck.latest(out / "checkpoints"))
+    assert meta["rounds_done"] == 2 and meta["battles"] == 1 and meta["updates"] > 0
+
+    summary = train_in_engine(None, out, progress=False, resume=True)
     with open(out / "metrics" / "rounds.csv") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == rounds and [int(r["round"]) for r in rows] == [1, 2, 3]
-    # per-round score parts add up to the engine's own battle totals (its results file rounds half up)
-    res = parse_results_text((out / "engine" / "results.txt").read_text())
-    ours = next(c for c in res.contestants if c.name.startswith("confront.BridgeBot"))
-    duck = next(c for c in res.contestants if c.name == "sample.SittingDuck")
-    for side, row in (("ours", ours), ("theirs", duck)):
-        for part, key in ENGINE_PARTS.items():
-            assert sum(float(r[f"{part}_{side}"]) for r in rows) == pytest.approx(getattr(row, key), abs=0.5)
-        assert sum(float(r[f"score_{side}"]) for r in rows) == pytest.approx(row.total, abs=0.5)
-    assert ours.total > 0  # it hit the duck
+    assert rows[:2] == first and [int(r["battle"]) for r in rows] == [0, 0, 1]
+    assert summary["battles"] == 2 and summary["updates"] > meta["updates"]
+    # per-round score parts add up to the engine's own totals of each battle (its results file rounds half up)
+    for battle, mine in ((0, rows[:2]), (1, rows[2:])):
+        res = parse_results_text((out / "engine" / f"battle-{battle:03d}" / "results.txt").read_text())
+        ours = next(c for c in res.contestants if c.name.startswith("confront.BridgeBot"))
+        duck = next(c for c in res.contestants if c.name == "sample.SittingDuck")
+        for side, row in (("ours", ours), ("theirs", duck)):
+            for part, key in ENGINE_PARTS.items():
+                assert sum(float(r[f"{part}_{side}"]) for r in mine) == pytest.approx(getattr(row, key), abs=0.5)
+            assert sum(float(r[f"score_{side}"]) for r in mine) == pytest.approx(row.total, abs=0.5)
+        assert ours.total > 0  # it hit the duck
     assert summary["rounds"] == rounds and summary["sessions"] == rounds
     sim_keys = {"name", "run", "scenario", "rounds", "sessions", "decisions", "final_score_ratio",
                 "final_window_rounds", "win_rate_last", "score_ours", "score_theirs", "learner", "wall_time_s",
                 "figures", "replay", "n_actions", "n_features"}  # train_run's summary (simulator)
     assert sim_keys <= summary.keys() and {"skipped_turns", "bridge_failures"} <= summary.keys()
-    assert summary["score_ours"] == pytest.approx(ours.total, abs=0.5)
+    assert summary["score_ours"] == pytest.approx(sum(float(r["score_ours"]) for r in rows))
     # a robot whose Python answer is late on a loaded machine falls back for the rest of its round: reported,
     # not fatal, so only protocol errors are ruled out here
     assert summary["bridge_errors"] == [] and all("bridge-failed" in f for f in summary["bridge_failures"])
@@ -104,6 +130,15 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path) -> 
     assert info["engine"] == "robocode" and learner.step == summary["updates"]
     assert np.ptp(learner.state_dict()["q"]) > 0  # the saved Q table moved away from its constant start
     assert (out / "config.toml").exists() and (out / "metrics" / "sessions.csv").exists()
+
+
+def test_engine_resume_refuses_a_simulator_checkpoint(tmp_path: Path) -> None:
+    cfg = load_experiment("demo", ["arena.scenario=1v1", "opponent.kind=SittingDuck", "learner.kind=ssaq",
+                                   "train.rounds=4", "train.session_rounds=1", "train.checkpoint_every=2",
+                                   "train.replay=false", "arena.battles=1"])
+    train_run(cfg, tmp_path / "run", progress=False)
+    with pytest.raises(CheckpointError, match="simulator checkpoint"):
+        train_in_engine(None, tmp_path / "run", progress=False, resume=True)
 
 
 @pytest.mark.engine
@@ -126,7 +161,7 @@ def test_team_trains_against_exported_td_team_with_transfer(install, tmp_path: P
         (row,) = list(csv.DictReader(f))
     assert int(row["alive_ours"]) <= 4 and int(row["alive_theirs"]) <= 4
     assert int(row["alive_ours"]) + int(row["alive_theirs"]) >= 1
-    res = parse_results_text((tmp_path / "run" / "engine" / "results.txt").read_text())
+    res = parse_results_text((tmp_path / "run" / "engine" / "battle-000" / "results.txt").read_text())
     for side, name in (("ours", "Ours"), ("theirs", "Them")):
         team = next(c for c in res.contestants if name in c.name)
         assert float(row[f"score_{side}"]) == pytest.approx(team.total, abs=0.5)

@@ -6,7 +6,10 @@ Methods, all playing the paper's 4v4 scenario as team 0:
   :class:`SharedTeamVecEnv` has one sub-environment per (battle, our tank) over a
   :class:`~confront.arena.smdp.TeamBattleEnv`; needs the extra ``confront[baselines]``;
 - ``DMNN (FLM)``: the paper's method, trained by :func:`~confront.experiments.train.train_run`;
-- the scripted sample robots SpinBot, Walls, Tracker and RamFire as our team (no training).
+- the scripted sample robots SpinBot, Walls, Tracker and RamFire as our team (no training);
+- references that tell whether training helps: ``Random moves`` (each tank picks one of the four moves
+  uniformly at random every SMDP step, with the same gun/radar controller) and ``DMNN (untrained)`` (the
+  DMNN of the seed at its initialisation, greedy).
 
 Trained methods learn against the TD team (the paper's opponent, ``train.td_team`` artefact of the seed)
 for the same number of rounds; then every method plays ``eval_rounds`` greedy rounds against each opponent
@@ -45,11 +48,14 @@ except ImportError:  # the core install runs the scripted and paper methods only
     _VecEnvBase = object  # type: ignore[assignment,misc]
     HAVE_SB3 = False
 
-__all__ = ["BaselinesConfig", "SharedTeamVecEnv", "SB3Policy", "baselines_outcome", "train_sb3", "rank_table",
-           "HAVE_SB3"]
+__all__ = ["BaselinesConfig", "SharedTeamVecEnv", "SB3Policy", "RandomMoves", "baselines_outcome", "train_sb3",
+           "rank_table", "HAVE_SB3"]
 
 SB3_METHODS = ("DQN", "PPO")
 DMNN_METHOD = "DMNN (FLM)"
+RANDOM_METHOD = "Random moves"
+UNTRAINED_METHOD = "DMNN (untrained)"
+REFERENCE_METHODS = (RANDOM_METHOD, UNTRAINED_METHOD)
 CSV_COLUMNS = ("method", "seed", "opponent", "rounds", "score_ours", "score_theirs", "score_ratio",
                "train_rounds", "train_seconds")
 
@@ -65,6 +71,7 @@ class BaselinesConfig:
     opponents: tuple[str, ...] = ("td", "SpinBot")
     scripted: tuple[str, ...] = ("SpinBot", "Walls", "Tracker", "RamFire")
     sb3: tuple[str, ...] = SB3_METHODS
+    references: tuple[str, ...] = REFERENCE_METHODS
     gamma: float = 0.9  # discount per SMDP step, as the paper's learners (Table 2)
     steps_per_round: int = 80  # SMDP steps a 4v4 round lasts, about (measured: ~75); sizes the SB3 schedules
     dqn_learning_rate: float = 5e-4
@@ -87,6 +94,9 @@ class BaselinesConfig:
         for name in self.scripted:
             if name not in BOT_NAMES:
                 raise ValueError(f"scripted robot {name!r} is not one of {', '.join(BOT_NAMES)}")
+        for name in self.references:
+            if name not in REFERENCE_METHODS:
+                raise ValueError(f"reference method {name!r} is not one of {', '.join(REFERENCE_METHODS)}")
         for name in self.sb3:
             if name not in SB3_METHODS:
                 raise ValueError(f"sb3 method {name!r} is not one of {', '.join(SB3_METHODS)}")
@@ -255,6 +265,38 @@ class SB3Policy(Learner):
         self.model.policy.load_state_dict({k: torch.as_tensor(state[k]) for k in own})
 
 
+class RandomMoves(Learner):
+    """Reference policy: one of ``n_actions`` moves uniformly at random per decision, exploring or not."""
+
+    kind = "random"
+    observation = "discrete"
+
+    def __init__(self, n_actions: int) -> None:
+        if n_actions < 1:
+            raise ValueError(f"n_actions must be >= 1, got {n_actions}")
+        self.n_actions = n_actions
+        self.params = None
+
+    def act(self, obs: np.ndarray, rng: np.random.Generator, explore: bool = True) -> np.ndarray:
+        """Uniform random actions, one per observation."""
+        return rng.integers(0, self.n_actions, size=len(np.asarray(obs)))
+
+    def learn(self, batch: Transition) -> dict[str, float]:
+        """Nothing to learn."""
+        return {}
+
+    def diagnostics(self) -> dict[str, float]:
+        """Nothing to report."""
+        return {}
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """No parameters."""
+        return {}
+
+    def load_state_dict(self, state: dict[str, np.ndarray]) -> None:
+        """No parameters."""
+
+
 # -- one (method, seed) ------------------------------------------------------------------------------------------
 
 def _experiment(cfg: BaselinesConfig, seed: int, rounds: int) -> Any:
@@ -370,10 +412,16 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
         td_path = Path(summary["td_model"])
         extra.update(train_rounds=int(summary["rounds"]), train_seconds=float(summary["wall_time_s"]))
     else:
-        from confront.experiments.train import smdp_config
+        from confront.experiments.train import build_learner, smdp_config
 
-        scripted = method
-        _, td_path = td_team(exp, smdp_config(exp).n_actions)
+        smdp = smdp_config(exp)
+        _, td_path = td_team(exp, smdp.n_actions)
+        if method == RANDOM_METHOD:
+            policy = RandomMoves(smdp.n_actions)
+        elif method == UNTRAINED_METHOD:
+            policy = build_learner(exp, smdp.observation.n_features, smdp.n_actions)
+        else:
+            scripted = method
     rows = [{"method": method, "seed": seed, **r, **extra}
             for r in _evaluate(cfg, exp, seed, td_path, policy, scripted)]
     folder.mkdir(parents=True, exist_ok=True)
@@ -475,7 +523,7 @@ def baselines_outcome(n_seeds: int, out: Path, rounds: int | None, workers: int,
     else:
         skipped.update({f"{m} (SB3)": "stable_baselines3/torch not installed (pip install 'confront[baselines]')"
                         for m in cfg.sb3})
-    methods += list(cfg.scripted)
+    methods += list(cfg.references) + list(cfg.scripted)
     tasks = [(m, s) for m in methods for s in range(n_seeds)]
 
     args = [(m, cfg, s, rounds, root / "eval" / slug(m) / f"seed-{s}", dmnn[s].folder) for m, s in tasks]

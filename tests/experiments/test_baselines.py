@@ -10,7 +10,7 @@ import pytest
 
 from confront.arena.scenarios import get_scenario
 from confront.arena.smdp import TeamBattleEnv
-from confront.experiments.baselines import HAVE_SB3, BaselinesConfig, baselines_outcome, rank_table
+from confront.experiments.baselines import HAVE_SB3, BaselinesConfig, RandomMoves, baselines_outcome, rank_table
 from confront.learning.tabular import TabularParams, TabularQ
 
 B = 2  # battles
@@ -40,8 +40,21 @@ def test_config_rejects_bad_values() -> None:
         BaselinesConfig(opponents=())
     with pytest.raises(ValueError, match="'Nobody'"):
         BaselinesConfig(opponents=("td", "Nobody"))
+    with pytest.raises(ValueError, match="'Oracle'"):
+        BaselinesConfig(references=("Oracle",))
     with pytest.raises(ValueError, match="'Sitter'"):
         BaselinesConfig(scripted=("Sitter",))
+
+
+def test_random_moves_are_uniform_and_ignore_exploration() -> None:
+    policy = RandomMoves(4)
+    a = policy.act(np.zeros(40_000, dtype=np.int64), np.random.default_rng(0), explore=False)
+    counts = np.bincount(a, minlength=4)
+    assert a.shape == (40_000,) and counts.sum() == 40_000
+    assert np.all(np.abs(counts / 40_000 - 0.25) < 0.01)  # 4 standard errors at n = 40 000 is 0.0087
+    assert policy.state_dict() == {} and policy.learn(None) == {}  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="n_actions"):
+        RandomMoves(0)
 
 
 def test_rank_table_orders_by_first_opponent_and_lists_skipped() -> None:
@@ -141,14 +154,15 @@ def test_tiny_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     with (root / "results.csv").open() as fh:
         rows = list(csv.DictReader(fh))
     methods = {r["method"] for r in rows}
-    expected = {"DMNN (FLM)", "SpinBot", "Walls"} | ({"DQN (SB3)", "PPO (SB3)"} if HAVE_SB3 else set())
+    expected = ({"DMNN (FLM)", "Random moves", "DMNN (untrained)", "SpinBot", "Walls"}
+                | ({"DQN (SB3)", "PPO (SB3)"} if HAVE_SB3 else set()))
     assert methods == expected
     assert len(rows) == 2 * len(expected)  # every method against the TD team and SpinBot
     for r in rows:
         assert 0.0 <= float(r["score_ratio"]) <= 1.0
         total = float(r["score_ours"]) + float(r["score_theirs"])
         assert float(r["score_ratio"]) == pytest.approx(float(r["score_ours"]) / total)
-        if r["method"] in ("SpinBot", "Walls"):
+        if r["method"] in ("SpinBot", "Walls", "Random moves", "DMNN (untrained)"):
             assert int(r["train_rounds"]) == 0
         else:  # the budget; SB3 may overshoot by rounds that end in the same step (at most battles - 1)
             assert 4 <= int(r["train_rounds"]) <= 5

@@ -86,12 +86,74 @@ def _java_decisions(install, policy: ExportedPolicy, lines: list[str], tmp_path)
 
 def _compare(policy: ExportedPolicy, lines: list[str], java: list[list[float]]) -> None:
     assert len(java) == len(lines)
-    for line, (a, gun, radar, fire) in zip(lines, java, strict=True):
+    for line, (a, gun, radar, fire, state) in zip(lines, java, strict=True):
         obs = parse_observation(line, HELLO)
         assert policy.act(obs) == int(a), line
+        assert policy.state_and_features(obs)[0] == int(state), line
         pg, pr, pf = policy.gun_radar(obs)
         assert (math.isnan(pg) and math.isnan(gun)) or gun == pytest.approx(pg, abs=1e-12)
         assert radar == pytest.approx(pr, abs=1e-12) and fire == pf
+
+
+def _sim_observations(steps: int = 40) -> tuple[list[str], list[tuple[int, float, float, float]]]:
+    """Every living tank's view in 4v4 simulator battles (own state, and the enemies it knows: its scan
+    memory) as bridge observation lines, with the simulator's discrete state and the commands its compiled
+    controller gave that tank for the turn (gun, radar, fire)."""
+    from confront.arena.smdp import SMDPConfig, TeamBattleEnv
+
+    env = TeamBattleEnv("4v4", n_battles=2, seed=3, opponents="td", config=SMDPConfig(turns_per_step=1))
+    env.reset()
+    rng = np.random.default_rng(4)
+    lines: list[str] = []
+    expected: list[tuple[int, float, float, float]] = []
+    s, team = env.arena.state, env.team_ids()
+    for _ in range(steps):
+        before = [(b, i) for b in range(2) for i in range(8) if s.alive[b, i]]
+        _, disc, _ = env.observe()
+        views = []
+        for b, i in before:
+            scans = tuple(Scan(f"r{j}", int(s.scan_time[b, i, j]), False, 0.0, 0.0, 0.0, 0.0,
+                               float(env._memory[b, 2, i, j]), float(env._memory[b, 0, i, j]),
+                               float(env._memory[b, 1, i, j]))
+                          for j in range(8) if team[j] != team[i] and s.alive[b, j] and s.scan_time[b, i, j] >= 0)
+            views.append(Observation(f"r{i}", (), 0, int(s.time[b]) + 1, float(s.x[b, i]), float(s.y[b, i]),
+                                     float(s.heading[b, i]), float(s.gun_heading[b, i]), float(s.radar_heading[b, i]),
+                                     float(s.velocity[b, i]), float(s.energy[b, i]), float(s.gun_heat[b, i]), 7, 0.0,
+                                     800.0, 600.0, scans))
+        env.step(rng.integers(0, 4, size=(2, 8)))
+        for (b, i), obs in zip(before, views, strict=True):
+            lines.append(format_observation(obs))
+            expected.append((int(disc[b, i]), *(float(v) for v in env._cmd[b, i, 2:5])))
+    return lines, expected
+
+
+def test_export_twin_equals_the_simulator_on_its_own_observations() -> None:
+    # the simulator's observation, target and controller, fed the same knowledge, decide like the exported twin
+    policy = _q_policy(6)
+    lines, expected = _sim_observations()
+    unknown = stale = fired = 0
+    for line, (state, gun, radar, fire) in zip(lines, expected, strict=True):
+        obs = parse_observation(line, HELLO)
+        assert policy.state_and_features(obs)[0] == state, line
+        pg, pr, pf = policy.gun_radar(obs)
+        assert (math.isnan(pg) and math.isnan(gun)) or gun == pytest.approx(pg, abs=1e-12), line
+        assert radar == pytest.approx(pr, abs=1e-12) and fire == pf, line
+        unknown += not obs.enemies()
+        stale += any(s.time < obs.turn - 1 for s in obs.enemies())
+        fired += fire > 0
+    # the cases that matter occur: no enemy known yet, stale scans, shots
+    assert unknown > 0 and stale > 0 and fired > 0
+
+
+@pytest.mark.engine
+def test_java_inference_equals_the_simulator_on_its_observations(install, tmp_path) -> None:
+    policy = _q_policy(6)
+    lines, expected = _sim_observations()
+    java = _java_decisions(install, policy, lines, tmp_path)
+    _compare(policy, lines, java)
+    for (state, gun, radar, fire), (_, jg, jr, jf, js) in zip(expected, java, strict=True):
+        assert int(js) == state and jf == fire and jr == pytest.approx(radar, abs=1e-12)
+        assert (math.isnan(gun) and math.isnan(jg)) or jg == pytest.approx(gun, abs=1e-12)
 
 
 @pytest.mark.engine

@@ -6,7 +6,8 @@ import java.io.InputStreamReader;
 
 /**
  * Prints the exported policy's decisions for bridge observation lines read from stdin, one output line
- * per input: "ACTION GUN RADAR FIRE". Arguments: POLICY_FILE WIDTH HEIGHT.
+ * per input: "ACTION GUN RADAR FIRE STATE" (STATE: the paper's discrete state 0..319). Arguments:
+ * POLICY_FILE WIDTH HEIGHT.
  */
 public final class PolicyCheck {
     public static void main(String[] args) throws Exception {
@@ -49,7 +50,9 @@ public final class PolicyCheck {
             ee = java.util.Arrays.copyOf(ee, n);
             int a = m.act(x, y, heading, energy, ex, ey, ee, width, height);
             double[] g = m.gunRadar(x, y, gunH, radarH, heat, energy, ex, ey);
-            out.append(a).append(' ').append(g[0]).append(' ').append(g[1]).append(' ').append(g[2]).append('\n');
+            int state = m.state(x, y, heading, PolicyModel.nearest(x, y, ex, ey), ex, ey, m.maxDistance(width, height));
+            out.append(a).append(' ').append(g[0]).append(' ').append(g[1]).append(' ').append(g[2]).append(' ')
+                    .append(state).append('\n');
         }
         System.out.print(out);
     }

@@ -1,18 +1,25 @@
-"""Python side of the engine bridge: a loopback TCP server that answers BridgeBot's per-turn requests.
+"""Python side of the engine bridge: a loopback TCP server that answers BridgeBot's requests.
 
-Protocol v1, one line per message (UTF-8). Robot -> Python:
-- once per round and connection, JSON ``{"v": 1, "type": "hello", "token", "name", "team" (team-mates'
+Protocol v2, one line per message (UTF-8). Robot -> Python:
+- once per round and connection, JSON ``{"v": 2, "type": "hello", "token", "name", "team" (team-mates'
   names joined by ";"), "round", "rounds", "width", "height"}``;
-- every turn ``O ROUND TURN X Y HEADING GUN_HEADING RADAR_HEADING VELOCITY ENERGY GUN_HEAT OTHERS
-  DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS``: SCANS is the latest sighting of each robot, joined by "|",
-  each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``; EVENTS a JSON list of
-  the events since the last turn; TURN is the engine turn the answer takes effect in;
-- ``E ROUND TIME HOW ENERGY`` at death or round end.
-Python -> robot: ``OK 1`` after a valid hello, ``A TURN AHEAD TURN GUN RADAR FIRE`` per observation
-(radians, + clockwise; ``NaN`` keeps the remaining value; fire 0 = no shot). A compact text line instead
-of JSON keeps the per-turn cost low (measured: docs/engine.md). A robot whose Python side fails (no answer
-within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the round and
-reports ``bridge-failed``; the runner collects those reports.
+- in turns 1, 1 + EVERY, 1 + 2 EVERY, ... ``O ROUND TURN X Y HEADING GUN_HEADING RADAR_HEADING VELOCITY
+  ENERGY GUN_HEAT OTHERS DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS``: SCANS is the latest sighting of each
+  robot, joined by "|", each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``;
+  EVENTS a JSON list of the events since the last observation; TURN is the engine turn the answer takes
+  effect in;
+- ``E ROUND TIME HOW ENERGY DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US`` at death or round end: the
+  round's decisions, their summed round trips (robot sends .. reads the answer) and how many took over 1 ms,
+  the turns played and the robot's own time outside ``execute()`` (deciding and the controller).
+Python -> robot: ``OK 2 EVERY N`` after a valid hello, followed by N ``key value`` lines: the parameters of
+the fixed gun/radar controller (:class:`~confront.arena.control.ControlConfig`) that the robot then runs in
+Java every turn (N = 0: no controller, the answers' gun, radar and fire are used);
+``A TURN AHEAD TURN GUN RADAR FIRE`` per observation (radians, + clockwise; ``NaN`` keeps the remaining
+value; fire 0 = no shot). Between decisions the robot's commands keep running (remaining distance and
+turns) with no round trip. A compact text line instead of JSON keeps the cost low (measured:
+docs/engine.md). A robot whose Python side fails (no answer within its timeout, closed socket, bad line)
+plays a built-in behaviour for the rest of the round and reports ``bridge-failed``; the runner collects
+those reports.
 """
 
 from __future__ import annotations
@@ -25,11 +32,14 @@ import secrets
 import socket
 import sys
 import threading
+import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
-PROTOCOL_VERSION = 1
+from confront.arena.control import ControlConfig
+
+PROTOCOL_VERSION = 2
 LOOPBACK = "127.0.0.1"
 MAX_LINE = 1 << 20
 
@@ -81,6 +91,39 @@ class Observation:
 Action = Sequence[float]
 Policy = Callable[[Observation], Action]
 
+
+@dataclass(frozen=True)
+class BridgeSettings:
+    """What the robots do on their own: how often they ask the policy, and whether they aim by themselves.
+
+    ``every``: the robots ask in turns 1, 1 + every, ... (the paper's SMDP step T); the commands keep running
+    in between. ``controller``: run this fixed gun/radar controller in Java every turn (PolicyModel's, the
+    exported robot's), so a policy that decides only the move needs no round trip between decisions; None:
+    the policy's gun, radar and fire answers are used (and hold between decisions).
+    """
+
+    every: int = 1
+    controller: ControlConfig | None = None
+
+    def __post_init__(self) -> None:
+        if self.every < 1:
+            raise ValueError(f"every must be >= 1, got {self.every}")
+
+    def hello_reply(self) -> str:
+        """``OK 2 EVERY N`` and the controller's N ``key value`` lines (the policy file's, export.py)."""
+        lines = controller_lines(self.controller) if self.controller is not None else []
+        return "".join(line + "\n" for line in [f"OK {PROTOCOL_VERSION} {self.every} {len(lines)}", *lines])
+
+
+def controller_lines(control: ControlConfig) -> list[str]:
+    """The controller's parameters as the ``key value`` lines that PolicyModel.java reads."""
+    out = []
+    for f in fields(ControlConfig):
+        v = getattr(control, f.name)
+        out.append(f"{f.name} {int(v) if isinstance(v, bool) else repr(float(v))}")
+    return out
+
+
 def _num(d: dict[str, Any], key: str) -> float:
     v = d.get(key)
     if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
@@ -120,6 +163,13 @@ def _finite(text: str, what: str) -> float:
 _OBS_FIELDS = 13
 
 
+def _floats(texts: Sequence[str], what: str) -> list[float]:
+    vals = [float(v) for v in texts]
+    if not all(map(math.isfinite, vals)):
+        raise ValueError(f"non-finite {what}: {texts}")
+    return vals
+
+
 def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
     """Validate one ``O ...`` line (from the robot introduced by ``hello``) into an :class:`Observation`."""
     parts = line.split("\t")
@@ -127,14 +177,14 @@ def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
     if len(parts) != 3 or head[0] != "O" or len(head) != _OBS_FIELDS:
         raise ValueError(f"bad observation line: {line[:80]!r}")
     rnd, turn, others = int(head[1]), int(head[2]), int(head[11])
-    x, y, heading, gun, radar, vel, energy, heat = (_finite(v, "state value") for v in head[3:11])
+    x, y, heading, gun, radar, vel, energy, heat = _floats(head[3:11], "state value")
     remaining = _finite(head[12], "distance_remaining")
     scans = []
     for item in parts[1].split("|") if parts[1] else ():
         f = item.split(";")
         if len(f) != 10 or f[2] not in ("0", "1"):
             raise ValueError(f"bad scan: {item[:80]!r}")
-        scans.append(Scan(f[0], int(f[1]), f[2] == "1", *(_finite(v, "scan value") for v in f[3:])))
+        scans.append(Scan(f[0], int(f[1]), f[2] == "1", *_floats(f[3:], "scan value")))
     events: tuple[dict[str, Any], ...] = ()
     if parts[2] != "[]":
         raw = json.loads(parts[2])
@@ -182,6 +232,23 @@ class BridgeStats:
     decisions: int = 0
     rounds_ended: int = 0
     errors: list[str] = field(default_factory=list)
+    policy_s: float = 0.0  # time inside the policy
+    handling_s: float = 0.0  # the server's own time per decision: parse, format, send (policy excluded)
+    # as the robots measured them (sums over the rounds they ended while connected)
+    robot_decisions: int = 0
+    rtt_total_us: int = 0
+    rtt_over_1ms: int = 0
+    robot_turns: int = 0
+    work_us: int = 0
+
+    def add_round_end(self, fields: Sequence[str]) -> None:
+        """Add a robot's round statistics: DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US."""
+        n, rtt, slow, turns, work = (int(v) for v in fields)
+        self.robot_decisions += n
+        self.rtt_total_us += rtt
+        self.rtt_over_1ms += slow
+        self.robot_turns += turns
+        self.work_us += work
 
 
 class BridgeServer:
@@ -191,8 +258,12 @@ class BridgeServer:
     calls are serialised by a lock, so the policy need not be thread-safe.
     """
 
-    def __init__(self, policy: Policy, token: str | None = None, port: int = 0) -> None:
+    def __init__(
+        self, policy: Policy, token: str | None = None, port: int = 0, settings: BridgeSettings | None = None
+    ) -> None:
         self.policy = policy
+        self.settings = settings or BridgeSettings()
+        self._reply = self.settings.hello_reply().encode()
         self.token = token if token is not None else secrets.token_hex(16)
         self.stats = BridgeStats()
         self.on_hello: Callable[[dict], None] | None = None
@@ -262,19 +333,30 @@ class BridgeServer:
                         hello = parse_hello(line, self.token)
                         if self.on_hello is not None:
                             self.on_hello(hello)
-                        sock.sendall(f"OK {PROTOCOL_VERSION}\n".encode())
+                        sock.sendall(self._reply)
                     elif line.startswith("E "):
+                        parts = line.split(" ")
+                        if len(parts) != 10:
+                            raise ValueError(f"bad end line: {line[:80]!r}")
                         with self._lock:
                             self.stats.rounds_ended += 1
+                            self.stats.add_round_end(parts[5:])
                             end = getattr(self.policy, "end_episode", None)
                             if end is not None:  # e.g. a learner's last SMDP step of the round
-                                end(hello["name"], int(line.split(" ")[1]))
+                                end(hello["name"], int(parts[1]))
                     else:
+                        t0 = time.perf_counter()
                         obs = parse_observation(line, hello)
                         with self._lock:
+                            t1 = time.perf_counter()
                             action = self.policy(obs)
-                            self.stats.decisions += 1
+                            t2 = time.perf_counter()
                         sock.sendall(format_action(obs.turn, action).encode())
+                        t3 = time.perf_counter()
+                        with self._lock:
+                            self.stats.decisions += 1
+                            self.stats.policy_s += t2 - t1
+                            self.stats.handling_s += (t1 - t0) + (t3 - t2)
         except OSError as err:
             if not self._stop.is_set():
                 self._error(f"{hello['name'] if hello else '?'}: connection: {err}")

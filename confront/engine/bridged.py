@@ -6,8 +6,9 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
+from confront.arena.control import ControlConfig
 from confront.engine.battle import BattleSpec
-from confront.engine.bridge import BridgeServer, Policy
+from confront.engine.bridge import BridgeServer, BridgeSettings, Policy
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 
 BRIDGE_BOT = "confront.BridgeBot*"
@@ -24,26 +25,25 @@ def bridge_timeout_ms(cpu_constant_ms: float) -> int:
     return max(50, int(20 * cpu_constant_ms))
 
 
-def bridge_options(
-    options: EngineOptions, port: int, token: str, timeout_ms: int, every: int = 1
-) -> EngineOptions:
-    """Engine options for a bridged battle: sandbox off (sockets), bridge settings as system properties.
-
-    ``every``: the robots ask Python in every ``every``-th turn (the paper's SMDP step T); in the turns
-    between, their last commands keep running (remaining distance and turns; a shot is fired only once).
-    """
+def bridge_options(options: EngineOptions, port: int, token: str, timeout_ms: int) -> EngineOptions:
+    """Engine options for a bridged battle: sandbox off (sockets), where and how long to wait as system
+    properties (the decision interval and the controller come from the server's hello reply)."""
     if timeout_ms <= 0:
         raise ValueError(f"timeout_ms must be > 0, got {timeout_ms}")
-    if every < 1:
-        raise ValueError(f"every must be >= 1, got {every}")
     props = (f"-Dconfront.bridge.port={port}", f"-Dconfront.bridge.token={token}",
-             f"-Dconfront.bridge.timeoutMs={timeout_ms}", f"-Dconfront.bridge.every={every}")
+             f"-Dconfront.bridge.timeoutMs={timeout_ms}")
     return replace(options, nosecurity=True, extra_jvm_args=options.extra_jvm_args + props)
 
 
 @dataclass(frozen=True)
 class BridgedRun:
-    """An engine run plus what the bridge saw: decisions served, errors, robots that fell back."""
+    """An engine run plus what the bridge saw: decisions served, errors, robots that fell back, and times.
+
+    Per decision, means in microseconds: ``rtt_mean_us`` the round trip as the robots timed it,
+    ``policy_us`` inside the policy, ``handling_us`` the server's own work (parse, format, send); per robot
+    turn ``work_us_per_turn`` the robots' own time outside execute() (deciding, round trips included, and the
+    controller). Statistics of a round that a robot played in fallback are lost with its connection.
+    """
 
     run: EngineRun
     decisions: int
@@ -52,6 +52,9 @@ class BridgedRun:
     failures: tuple[str, ...]
     rtt_mean_us: float = float("nan")
     rtt_over_1ms: int = 0
+    work_us_per_turn: float = float("nan")
+    policy_us: float = float("nan")
+    handling_us: float = float("nan")
 
     @property
     def ok(self) -> bool:
@@ -64,19 +67,6 @@ def bridge_failures(run: EngineRun) -> tuple[str, ...]:
     return tuple(r for r in run.summary.get("robot_reports", []) if "bridge-failed" in r)
 
 
-def rtt_stats(run: EngineRun) -> tuple[float, int]:
-    """Mean round trip (robot sends its observation .. reads the answer) in microseconds, and how many
-    round trips took over 1 ms, from the robots' per-round 'bridge-stats' reports."""
-    n = total = slow = 0
-    for rep in run.summary.get("robot_reports", []):
-        if "bridge-stats" in rep:
-            fields = dict(kv.split("=") for kv in rep.split() if "=" in kv)
-            n += int(fields["decisions"])
-            total += int(fields["rtt_total_us"])
-            slow += int(fields["rtt_over_1ms"])
-    return (total / n if n else float("nan")), slow
-
-
 def run_bridged_battle(
     spec: BattleSpec,
     policy: Policy,
@@ -85,18 +75,27 @@ def run_bridged_battle(
     workdir: str | os.PathLike[str] | None = None,
     every: int = 1,
     extra_robots: Sequence[str | os.PathLike[str]] = (),
+    controller: ControlConfig | None = None,
 ) -> BridgedRun:
     """Run ``spec`` (whose contestants include BridgeBot tanks) with ``policy`` deciding for every BridgeBot.
 
-    The robots skip turn 1 (they act once before connecting) and then ask ``policy`` every ``every`` turns.
-    ``extra_robots``: robot jars or folders to add (e.g. exported PolicyBot opponents).
+    The robots connect before their first action and ask ``policy`` in turns 1, 1 + every, ... (the paper's
+    SMDP step T); the commands keep running in between. ``controller``: the robots run this fixed gun/radar
+    controller themselves every turn (the answers' gun, radar and fire are then ignored), so a policy that
+    only picks moves costs one round trip per ``every`` turns. ``extra_robots``: robot jars or folders to add
+    (e.g. exported PolicyBot opponents).
     """
     opts = options or EngineOptions(cpu_constant_ms=BRIDGE_CPU_CONSTANT_MS)
     tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)
-    with BridgeServer(policy) as server:
-        run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo, every), workdir=workdir,
+    with BridgeServer(policy, settings=BridgeSettings(every, controller)) as server:
+        run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo), workdir=workdir,
                          extra_robots=extra_robots)
-    mean_rtt, slow = rtt_stats(run)
-    return BridgedRun(run=run, decisions=server.stats.decisions, connections=server.stats.connections,
-                      server_errors=tuple(server.stats.errors), failures=bridge_failures(run),
-                      rtt_mean_us=mean_rtt, rtt_over_1ms=slow)
+    st = server.stats
+    nan = float("nan")
+    return BridgedRun(run=run, decisions=st.decisions, connections=st.connections,
+                      server_errors=tuple(st.errors), failures=bridge_failures(run),
+                      rtt_mean_us=st.rtt_total_us / st.robot_decisions if st.robot_decisions else nan,
+                      rtt_over_1ms=st.rtt_over_1ms,
+                      work_us_per_turn=st.work_us / st.robot_turns if st.robot_turns else nan,
+                      policy_us=1e6 * st.policy_s / st.decisions if st.decisions else nan,
+                      handling_us=1e6 * st.handling_s / st.decisions if st.decisions else nan)

@@ -11,6 +11,8 @@ from confront.engine.install import EngineInstall
 from confront.engine.java_build import ROBOT_CLASSES, ROBOT_HELPERS
 
 SAMPLE_PACKAGES: tuple[str, ...] = ("sample", "sampleteam")
+# BridgeBot runs the exported robot's gun/radar controller (PolicyModel) between decisions
+BRIDGE_HELPERS: tuple[str, ...] = ("PolicyModel",)
 
 
 def prepare_workdir(
@@ -42,7 +44,7 @@ def prepare_workdir(
             shutil.copytree(install.samples / pkg, robots / pkg)
     ours = robots / "confront"
     ours.mkdir(exist_ok=True)
-    for helper in ROBOT_HELPERS:
+    for helper in ROBOT_HELPERS + BRIDGE_HELPERS:
         shutil.copy2(classes / "confront" / f"{helper}.class", ours / f"{helper}.class")
     for cls in ROBOT_CLASSES:
         for f in (classes / "confront").glob(f"{cls}*.class"):

@@ -7,11 +7,13 @@ import sys
 import threading
 import time
 
+import numpy as np
 import pytest
 
 from confront.engine.battle import BattleSpec, scenario_battle
 from confront.engine.bridge import Observation, nearest_enemy_policy
 from confront.engine.bridged import BRIDGE_BOT, bridge_failures, bridge_options, run_bridged_battle
+from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.runner import EngineOptions, run_battle
 
 pytestmark = pytest.mark.engine
@@ -95,3 +97,27 @@ def test_python_killed_mid_battle(install) -> None:
     assert any("round=1" in f for f in failures)  # lost during round 1
     assert any("round=2" in f and "connect" in f for f in failures)  # nobody listening any more
     assert run.results.rounds == 3 and len(run.round_turns) == 3
+
+
+def test_java_controller_between_decisions_plays_like_the_exported_robot(install, tmp_path) -> None:
+    """every=T with the controller in Java: one round trip per T turns, and the battle of the exported robot."""
+    policy = ExportedPolicy("qtable", q=np.random.default_rng(4).normal(size=(320, 4)), step_turns=5)
+    turns: list[tuple[int, int]] = []
+
+    def asked(obs: Observation):
+        turns.append((obs.round, obs.turn))
+        return policy(obs)
+
+    opts = EngineOptions(seed=2, cpu_constant_ms=50)
+    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "Walls"), rounds=2), asked, opts, every=5,
+                             controller=policy.control)
+    java = run_battle(BattleSpec(("confront.PolicyBot*", "Walls"), rounds=2), opts,
+                      extra_robots=[export_robot(policy, tmp_path / "robots")])
+    assert res.ok, (res.failures, res.server_errors)
+    assert (0, 1) in turns and (1, 1) in turns and all((t - 1) % 5 == 0 for _, t in turns)
+    assert res.decisions == len(turns) and res.decisions * 5 <= res.run.turns
+    assert res.work_us_per_turn > 0 and res.rtt_mean_us > 0
+    if not res.run.skipped_turns and not java.skipped_turns:  # a skipped turn changes the rest of a battle
+        assert res.run.round_turns == java.round_turns
+        assert [(c.name.startswith("sample."), c.total) for c in res.run.results.contestants] == [
+            (c.name.startswith("sample."), c.total) for c in java.results.contestants]

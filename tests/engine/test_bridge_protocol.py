@@ -1,4 +1,4 @@
-"""Bridge protocol v1: message validation and a real loopback round trip (no engine needed)."""
+"""Bridge protocol v2: message validation and a real loopback round trip (no engine needed)."""
 
 from __future__ import annotations
 
@@ -6,11 +6,14 @@ import json
 import math
 import socket
 import time
+from dataclasses import fields
 
 import pytest
 
+from confront.arena.control import ControlConfig
 from confront.engine.bridge import (
     BridgeServer,
+    BridgeSettings,
     Observation,
     format_action,
     load_policy,
@@ -19,7 +22,7 @@ from confront.engine.bridge import (
     parse_observation,
 )
 
-HELLO = {"v": 1, "type": "hello", "token": "t0k", "name": "confront.BridgeBot* (1)",
+HELLO = {"v": 2, "type": "hello", "token": "t0k", "name": "confront.BridgeBot* (1)",
          "team": "confront.BridgeBot* (2)", "round": 0, "rounds": 3, "width": 800.0, "height": 600.0}
 SCAN_WALLS = "sample.Walls;6;0;0.5;300.0;1.0;-8.0;80.0;400.0;200.0"
 SCAN_MATE = "confront.BridgeBot* (2);5;1;0.1;50.0;2.0;0.0;100.0;105.0;250.0"
@@ -61,7 +64,19 @@ def test_bad_hello_rejected() -> None:
     with pytest.raises(ValueError, match="token"):
         parse_hello(json.dumps(HELLO), "other")
     with pytest.raises(ValueError, match="version"):
-        parse_hello(json.dumps({**HELLO, "v": 0}), "t0k")
+        parse_hello(json.dumps({**HELLO, "v": 1}), "t0k")
+
+
+def test_hello_reply_carries_interval_and_controller() -> None:
+    assert BridgeSettings().hello_reply() == "OK 2 1 0\n"
+    ctl = ControlConfig(power_near=2.5, fire=False)
+    lines = BridgeSettings(10, ctl).hello_reply().splitlines()
+    n = len(fields(ControlConfig))
+    assert lines[0] == f"OK 2 10 {n}" and len(lines) == n + 1
+    assert "power_near 2.5" in lines and "fire 0" in lines and "near_distance 150.0" in lines
+    assert f"turn_angle {math.radians(45.0)!r}" in lines
+    with pytest.raises(ValueError, match="every"):
+        BridgeSettings(0)
 
 
 def test_format_action() -> None:
@@ -103,14 +118,14 @@ def test_server_round_trip_on_loopback() -> None:
         seen.append(obs)
         return (obs.turn * 1.0, math.nan, 0.0, 0.0, 1.5)
 
-    with BridgeServer(policy, token="t0k") as server:
+    with BridgeServer(policy, token="t0k", settings=BridgeSettings(every=5)) as server:
         assert server.port > 0
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps(HELLO) + "\n").encode())
-            assert _lines(s, 1) == ["OK 1"]
+            assert _lines(s, 1) == ["OK 2 5 0"]
             s.sendall((obs_line() + "\n" + obs_line(turn=8, scans="", events="[]") + "\n").encode())
             assert _lines(s, 2) == ["A 7 7.0 NaN 0.0 0.0 1.5", "A 8 8.0 NaN 0.0 0.0 1.5"]
-            s.sendall(b"E 0 9 death 0.0\n")
+            s.sendall(b"E 0 9 death 0.0 2 300 1 9 450\n")
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps({**HELLO, "token": "bad"}) + "\n").encode())
             assert _lines(s, 1) == []  # closed without an answer
@@ -119,4 +134,7 @@ def test_server_round_trip_on_loopback() -> None:
             time.sleep(0.01)
     assert [o.turn for o in seen] == [7, 8] and seen[1].scans == () and seen[1].events == ()
     assert server.stats.decisions == 2 and server.stats.connections == 2 and server.stats.rounds_ended == 1
+    assert server.stats.policy_s > 0 and server.stats.handling_s > 0
+    st = server.stats
+    assert (st.robot_decisions, st.rtt_total_us, st.rtt_over_1ms, st.robot_turns, st.work_us) == (2, 300, 1, 9, 450)
     assert len(server.stats.errors) == 1 and "token" in server.stats.errors[0]

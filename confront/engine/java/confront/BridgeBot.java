@@ -4,6 +4,7 @@ import java.io.BufferedReader;
 import java.io.IOException;
 import java.io.InputStreamReader;
 import java.io.OutputStream;
+import java.io.StringReader;
 import java.net.InetAddress;
 import java.net.InetSocketAddress;
 import java.net.Socket;
@@ -24,29 +25,39 @@ import robocode.WinEvent;
 import robocode.util.Utils;
 
 /**
- * A tank that hands every turn's decision to a Python policy over a loopback TCP socket.
+ * A tank that takes its decisions from a Python policy over a loopback TCP socket.
  *
  * Settings come from JVM system properties (the engine runs with -DNOSECURITY=true so that robots may use
- * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs, confront.bridge.every
- * (ask Python in every k-th turn only; the commands keep running in between). Protocol version 1,
- * one line per message: the robot sends a JSON "hello" once per round, then an "O ..." observation line
- * every turn and "E ..." at death or round end (format in confront/engine/bridge.py); Python answers
- * "OK 1" to hello and "A TURN AHEAD TURN GUN RADAR FIRE" to each observation
- * (radians, + clockwise; "NaN" keeps the current remaining value; fire 0 = no shot). Any missing, late
- * or malformed answer switches the robot to a built-in behaviour for the rest of the round and prints
- * "CONFRONT bridge-failed REASON" for the runner to report.
+ * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs. Protocol version 2
+ * (format in confront/engine/bridge.py), one line per message: the robot sends a JSON "hello" once per round
+ * and Python answers "OK 2 EVERY N" plus N "key value" lines of the fixed gun/radar controller (N = 0: none).
+ * The robot then sends an "O ..." observation in turns 1, 1 + EVERY, 1 + 2 EVERY, ... and "E ..." at death
+ * or round end; Python answers each observation with "A TURN AHEAD TURN GUN RADAR FIRE" (radians,
+ * + clockwise; "NaN" keeps the current remaining value; fire 0 = no shot). Between decisions the commands keep
+ * running and, with a controller, PolicyModel's gun/radar controller aims and fires every turn (its commands
+ * replace the answer's gun, radar and fire), so no round trip is needed there. Any missing, late or malformed
+ * answer switches the robot to a built-in behaviour for the rest of the round and prints
+ * "CONFRONT bridge-failed REASON" for the runner to report. The "E" line carries the round's statistics:
+ * decisions, their round-trip times, turns played and the robot's own work time outside execute().
  */
 public class BridgeBot extends TeamRobot {
-    static final int VERSION = 1;
+    static final int VERSION = 2;
     private Socket socket;
     private BufferedReader in;
     private OutputStream out2;
     private boolean failed;
     private boolean finished;
+    private int every = 1;
+    private PolicyModel controller;
     private long rttN;
     private long rttSum;
     private long rttSlow;
-    private final Map<String, String> scans = new LinkedHashMap<>();
+    private long workNanos;
+    private long turnsPlayed;
+    // latest scan per robot: time, teammate (0/1), bearing, distance, heading, velocity, energy, x, y
+    private final Map<String, double[]> scans = new LinkedHashMap<>();
+    // enemies only, as PolicyBot keeps them: x, y, energy
+    private final Map<String, double[]> enemies = new LinkedHashMap<>();
     private final StringBuilder events = new StringBuilder();
     private double enemyBearing = Double.NaN;
     private long lastScan = -100;
@@ -56,22 +67,26 @@ public class BridgeBot extends TeamRobot {
         setAdjustGunForRobotTurn(true);
         setAdjustRadarForRobotTurn(true);
         setAdjustRadarForGunTurn(true);
-        // act once before connecting, after giving the engine time to wait for this first action
+        // the engine waits for this robot's first action; connecting first delays it past the engine's wait
         RoundStart.awaitEngine();
-        execute();
         connect();
-        int every = Integer.parseInt(System.getProperty("confront.bridge.every", "1"));
         while (true) {
-            if (!failed && !finished && (getTime() + 1) % every == 0) {
+            long t0 = System.nanoTime();
+            long turn = getTime() + 1;  // the commands set now take effect in this engine turn
+            if (!failed && !finished && (turn - 1) % every == 0) {
                 try {
-                    decide();
+                    decide(turn);
                 } catch (IOException | RuntimeException e) {
                     fail(e.getClass().getSimpleName() + ": " + e.getMessage());
                 }
             }
             if (failed) {
                 fallback();
+            } else if (controller != null) {
+                control();
             }
+            turnsPlayed++;
+            workNanos += System.nanoTime() - t0;
             execute();
         }
     }
@@ -95,12 +110,38 @@ public class BridgeBot extends TeamRobot {
                     + ",\"round\":" + getRoundNum() + ",\"rounds\":" + getNumRounds()
                     + ",\"width\":" + getBattleFieldWidth() + ",\"height\":" + getBattleFieldHeight() + "}");
             String reply = in.readLine();
-            if (!("OK " + VERSION).equals(reply)) {
+            String[] p = reply == null ? new String[0] : reply.split(" ");
+            if (p.length != 4 || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
                 fail("bad hello reply " + reply);
+                return;
+            }
+            every = Integer.parseInt(p[2]);
+            int n = Integer.parseInt(p[3]);
+            if (every < 1 || n < 0 || n > 100) {
+                fail("bad hello reply " + reply);
+                return;
+            }
+            if (n > 0) {
+                controller = controllerModel(n);
             }
         } catch (IOException | RuntimeException e) {
             fail("connect: " + e.getClass().getSimpleName() + ": " + e.getMessage());
         }
+    }
+
+    /** The controller's "key value" lines (confront.engine.bridge.controller_lines) as a PolicyModel. */
+    private PolicyModel controllerModel(int n) throws IOException {
+        StringBuilder text = new StringBuilder("confront-policy 1\nkind qtable\nstep_turns ").append(every)
+                .append("\ntarget nearest\nmax_distance 0.0\ninclude_position 0\n");
+        for (int i = 0; i < n; i++) {
+            String line = in.readLine();
+            if (line == null || line.split(" ").length != 2) {
+                throw new IOException("bad controller line " + line);
+            }
+            text.append(line).append('\n');
+        }
+        // PolicyModel reads a policy file; the controller needs no values, so a 1 x 4 table stands in
+        return PolicyModel.read(new StringReader(text.append("matrix q 1 4\n0 0 0 0\n").toString()));
     }
 
     private String teamName() {
@@ -108,20 +149,31 @@ public class BridgeBot extends TeamRobot {
         return mates == null ? "" : String.join(";", mates);
     }
 
-    private void decide() throws IOException {
-        long turn = getTime() + 1;  // the commands set now take effect in this engine turn
+    private void decide(long turn) throws IOException {
         StringBuilder b = new StringBuilder(256);
         b.append("O ").append(getRoundNum()).append(' ').append(turn)
                 .append(' ').append(getX()).append(' ').append(getY())
                 .append(' ').append(getHeadingRadians()).append(' ').append(getGunHeadingRadians())
                 .append(' ').append(getRadarHeadingRadians()).append(' ').append(getVelocity())
                 .append(' ').append(getEnergy()).append(' ').append(getGunHeat())
-                .append(' ').append(getOthers()).append(' ').append(getDistanceRemaining())
-                .append('\t').append(String.join("|", scans.values()))
-                .append("\t[").append(events).append(']');
+                .append(' ').append(getOthers()).append(' ').append(getDistanceRemaining()).append('\t');
+        boolean first = true;
+        for (Map.Entry<String, double[]> e : scans.entrySet()) {
+            double[] s = e.getValue();
+            if (!first) {
+                b.append('|');
+            }
+            first = false;
+            b.append(e.getKey()).append(';').append((long) s[0]).append(';').append((int) s[1]);
+            for (int i = 2; i < s.length; i++) {
+                b.append(';').append(s[i]);
+            }
+        }
+        b.append("\t[").append(events).append("]\n");
         events.setLength(0);
         long t0 = System.nanoTime();
-        send(b.toString());
+        out2.write(b.toString().getBytes(StandardCharsets.UTF_8));
+        out2.flush();
         String line = in.readLine();
         long dt = System.nanoTime() - t0;
         rttN++;
@@ -149,6 +201,9 @@ public class BridgeBot extends TeamRobot {
         if (!Double.isNaN(a[1])) {
             setTurnRightRadians(a[1]);
         }
+        if (controller != null) {
+            return;  // the controller sets gun, radar and fire
+        }
         if (!Double.isNaN(a[2])) {
             setTurnGunRightRadians(a[2]);
         }
@@ -160,8 +215,30 @@ public class BridgeBot extends TeamRobot {
         }
     }
 
-    private void send(String json) throws IOException {
-        out2.write((json + "\n").getBytes(StandardCharsets.UTF_8));
+    /** The fixed gun/radar controller on the enemies' last scans, as PolicyBot runs it every turn. */
+    private void control() {
+        int n = enemies.size();
+        double[] ex = new double[n];
+        double[] ey = new double[n];
+        int i = 0;
+        for (double[] v : enemies.values()) {
+            ex[i] = v[0];
+            ey[i] = v[1];
+            i++;
+        }
+        double[] g = controller.gunRadar(getX(), getY(), getGunHeadingRadians(), getRadarHeadingRadians(),
+                getGunHeat(), getEnergy(), ex, ey);
+        if (!Double.isNaN(g[0])) {
+            setTurnGunRightRadians(g[0]);
+        }
+        setTurnRadarRightRadians(g[1]);
+        if (g[2] > 0) {
+            setFire(g[2]);
+        }
+    }
+
+    private void send(String line) throws IOException {
+        out2.write((line + "\n").getBytes(StandardCharsets.UTF_8));
         out2.flush();
     }
 
@@ -211,20 +288,21 @@ public class BridgeBot extends TeamRobot {
     public void onScannedRobot(ScannedRobotEvent e) {
         double abs = getHeadingRadians() + e.getBearingRadians();
         boolean mate = isTeammate(e.getName());
+        double x = getX() + e.getDistance() * Math.sin(abs);
+        double y = getY() + e.getDistance() * Math.cos(abs);
         if (!mate) {
             enemyBearing = e.getBearingRadians();
             lastScan = e.getTime();
+            enemies.put(e.getName(), new double[] {x, y, e.getEnergy()});
         }
-        scans.put(e.getName(), e.getName() + ";" + e.getTime() + ";" + (mate ? 1 : 0)
-                + ";" + e.getBearingRadians() + ";" + e.getDistance() + ";" + e.getHeadingRadians()
-                + ";" + e.getVelocity() + ";" + e.getEnergy()
-                + ";" + (getX() + e.getDistance() * Math.sin(abs))
-                + ";" + (getY() + e.getDistance() * Math.cos(abs)));
+        scans.put(e.getName(), new double[] {e.getTime(), mate ? 1 : 0, e.getBearingRadians(), e.getDistance(),
+                e.getHeadingRadians(), e.getVelocity(), e.getEnergy(), x, y});
     }
 
     @Override
     public void onRobotDeath(RobotDeathEvent e) {
         scans.remove(e.getName());
+        enemies.remove(e.getName());
         event("{\"type\":\"robot_death\",\"name\":" + str(e.getName()) + "}");
     }
 
@@ -253,13 +331,12 @@ public class BridgeBot extends TeamRobot {
         if (finished) {
             return;
         }
-        // round-trip statistics of this round, for the runner's report
-        out.println("CONFRONT bridge-stats round=" + getRoundNum() + " decisions=" + rttN + " rtt_total_us="
-                + rttSum / 1000 + " rtt_over_1ms=" + rttSlow);
         finished = true;
         if (!failed && socket != null) {
             try {
-                send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy());
+                // with this round's round-trip and work-time statistics (a dead robot's output is not collected)
+                send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy() + " " + rttN + " "
+                        + rttSum / 1000 + " " + rttSlow + " " + turnsPlayed + " " + workNanos / 1000);
             } catch (IOException e) {
                 // the round is over anyway
             }

@@ -99,8 +99,19 @@ def _jump_tables(n: int) -> tuple[np.ndarray, np.ndarray]:
     return a, c
 
 
+def _reject_thresholds(n: int) -> np.ndarray:
+    """T[i]: nextInt(i) rejects a draw iff the generator state is >= T[i] (u = state >> 17 >= 2^31 - i, i not a
+    power of two; Random.nextInt); 2^48 (never) for powers of two."""
+    t = np.full(n + 2, 1 << 48, dtype=np.int64)
+    for i in range(2, n + 2):
+        if i & (i - 1):
+            t[i] = ((1 << 31) - i) << 17
+    return t
+
+
 _JUMP_N = 4096
 _JUMP_A, _JUMP_C = _jump_tables(_JUMP_N)
+_REJECT = _reject_thresholds(_JUMP_N)
 _MASK48 = (1 << 48) - 1
 
 
@@ -122,19 +133,20 @@ def skip_shuffle(rng: int, n: int, mode: int) -> int:
     """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
 
     Used where the engine's order cannot change the outcome (or is rebuilt lazily when it can). The n-1
-    draws are computed independently by jump-ahead; the rare case where nextInt could reject a draw
-    falls back to the step-by-step loop.
+    states are computed independently by jump-ahead and tested together (a loop without branches, which
+    the compiler vectorises); the rare case where nextInt could reject a draw falls back to the
+    step-by-step loop.
     """
     if mode != 0 or n < 2:
         return rng
     steps = n - 1
     if steps > _JUMP_N:
         return _skip_exact(rng, n)
-    for j in range(1, steps + 1):
-        u = ((_JUMP_A[j] * rng + _JUMP_C[j]) & _MASK48) >> 17
-        i = n - j + 1
-        if u >= (1 << 31) - i and (i & (i - 1)) != 0:
-            return _skip_exact(rng, n)
+    bad = False
+    for j in range(1, steps + 1):  # draw j is nextInt(n + 1 - j)
+        bad |= ((_JUMP_A[j] * rng + _JUMP_C[j]) & _MASK48) >= _REJECT[n + 1 - j]
+    if bad:
+        return _skip_exact(rng, n)
     return (_JUMP_A[steps] * rng + _JUMP_C[steps]) & _MASK48
 
 
@@ -786,6 +798,15 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
 
 
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                   placements, placements_total, cmd, params, scratch_i, scratch_f, n, k):
+    """_step_battle with battle b's rows of the scratch arrays."""
+    _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                 placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
+                 scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
+
+
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
 def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                placements, placements_total, cmd, params, scratch_i, scratch_f):
@@ -795,9 +816,8 @@ def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledge
     for b in range(b0, b1):
         if bb[b, DONE]:
             continue
-        _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
-                     placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
-                     scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
+        step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                       placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")

@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import _kernels as K
 from .core import Arena, _pool
 from .rules import normal_absolute_angle, normal_relative_angle
 from .scenarios import Scenario
@@ -442,68 +443,128 @@ def _finish_handler(mem, b, i, rem):
         mem[b, i, M_HSTART] = 0
 
 
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
+                 assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
+                 ev_hitby_bearing, ev_died, width, height, cmd, rem):
+    """One decision of battle b's scripted robots (their robot time between two turns)."""
+    n = x.shape[1]
+    others = 0
+    for i in range(n):
+        others += 1 if alive[b, i] else 0
+    for i in range(n):
+        kind = kinds[i]
+        if kind == K_CORNERS and ev_died[b, i]:
+            # Corners.onDeath: a poor round (under 75 % of the others killed) moves to the next corner
+            start = mem[b, i, M_VAR + 2]
+            if start > 0 and (start - others) / start < 0.75:
+                c = mem[b, i, M_STATIC] + 90
+                mem[b, i, M_STATIC] = -90.0 if c == 270 else c
+        if kind == K_NONE or kind == K_DUCK or not alive[b, i]:
+            continue
+        if energy[b, i] == 0.0:
+            continue
+        rem[0] = dist_rem[b, i]
+        rem[1] = body_rem[b, i]
+        rem[2] = gun_rem[b, i]
+        rem[3] = radar_rem[b, i]
+        _finish_handler(mem, b, i, rem)
+        _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot,
+                ev_robot_bearing, ev_fault, ev_hitby, ev_hitby_bearing, cmd)
+        t = int(mem[b, i, M_TARGET])
+        tx = x[b, t] if t >= 0 else 0.0
+        ty = y[b, t] if t >= 0 else 0.0
+        for _ in range(24):
+            in_handler = mem[b, i, M_HPRIO] > 0  # a handler with no operations ends at once
+            if in_handler:
+                base, lenp, posp, startp = M_HOPS, M_HLEN, M_HPOS, M_HSTART
+            else:
+                base, lenp, posp, startp = M_MOPS, M_MLEN, M_MPOS, M_MSTART
+            pos = int(mem[b, i, posp])
+            if pos >= int(mem[b, i, lenp]):
+                if in_handler:
+                    mem[b, i, M_HLEN] = 0
+                    mem[b, i, M_HPOS] = 0
+                    mem[b, i, M_HPRIO] = 0
+                    mem[b, i, M_HSTART] = 0
+                else:
+                    _refill_main(kind, mem, b, i, h[b, i], width, height, others - 1)
+                continue
+            op = mem[b, i, base + 2 * pos]
+            val = mem[b, i, base + 2 * pos + 1]
+            if mem[b, i, startp] == 1:
+                if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
+                    mem[b, i, posp] = pos + 1
+                    mem[b, i, startp] = 0
+                    continue
+                break  # still running: nothing new this turn
+            mem[b, i, startp] = 1
+            if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x[b, i], y[b, i], rem,
+                      gh[b, i] == rh[b, i]):
+                break
+        mem[b, i, M_FRESH] = 0.0
+
+
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
               ev_hitby_bearing, ev_died, width, height, cmd, rem):
     """One decision of every scripted robot (its robot time between two turns)."""
-    nb = x.shape[0]
-    n = x.shape[1]
-    for b in range(nb):
-        others = 0
-        for i in range(n):
-            others += 1 if alive[b, i] else 0
-        for i in range(n):
-            kind = kinds[i]
-            if kind == K_CORNERS and ev_died[b, i]:
-                # Corners.onDeath: a poor round (under 75 % of the others killed) moves to the next corner
-                start = mem[b, i, M_VAR + 2]
-                if start > 0 and (start - others) / start < 0.75:
-                    c = mem[b, i, M_STATIC] + 90
-                    mem[b, i, M_STATIC] = -90.0 if c == 270 else c
-            if kind == K_NONE or kind == K_DUCK or not alive[b, i]:
-                continue
-            if energy[b, i] == 0.0:
-                continue
-            rem[0] = dist_rem[b, i]
-            rem[1] = body_rem[b, i]
-            rem[2] = gun_rem[b, i]
-            rem[3] = radar_rem[b, i]
-            _finish_handler(mem, b, i, rem)
-            _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot,
-                    ev_robot_bearing, ev_fault, ev_hitby, ev_hitby_bearing, cmd)
-            t = int(mem[b, i, M_TARGET])
-            tx = x[b, t] if t >= 0 else 0.0
-            ty = y[b, t] if t >= 0 else 0.0
-            for _ in range(24):
-                in_handler = mem[b, i, M_HPRIO] > 0  # a handler with no operations ends at once
-                if in_handler:
-                    base, lenp, posp, startp = M_HOPS, M_HLEN, M_HPOS, M_HSTART
-                else:
-                    base, lenp, posp, startp = M_MOPS, M_MLEN, M_MPOS, M_MSTART
-                pos = int(mem[b, i, posp])
-                if pos >= int(mem[b, i, lenp]):
-                    if in_handler:
-                        mem[b, i, M_HLEN] = 0
-                        mem[b, i, M_HPOS] = 0
-                        mem[b, i, M_HPRIO] = 0
-                        mem[b, i, M_HSTART] = 0
-                    else:
-                        _refill_main(kind, mem, b, i, h[b, i], width, height, others - 1)
-                    continue
-                op = mem[b, i, base + 2 * pos]
-                val = mem[b, i, base + 2 * pos + 1]
-                if mem[b, i, startp] == 1:
-                    if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
-                        mem[b, i, posp] = pos + 1
-                        mem[b, i, startp] = 0
-                        continue
-                    break  # still running: nothing new this turn
-                mem[b, i, startp] = 1
-                if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x[b, i], y[b, i], rem,
-                          gh[b, i] == rh[b, i]):
-                    break
-            mem[b, i, M_FRESH] = 0.0
+    for b in range(x.shape[0]):
+        _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem,
+                     maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
+                     ev_hitby_bearing, ev_died, width, height, cmd, rem)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _clear_memory(mem, b):
+    """A new round: forget battle b's per-round bot memory (statics such as Corners' corner stay)."""
+    for i in range(mem.shape[1]):
+        for k in range(M_STATIC):
+            mem[b, i, k] = 0.0
+        mem[b, i, M_TARGET] = -1.0
+
+
+@njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
+def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger,
+               score, score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, fixed,
+               has_fixed, width, height, rem):
+    """``turns`` turns of battles b0..b1-1, each as ``commands``, ``Arena.step``, ``Arena.reset(done)``.
+
+    Battles are independent, so each runs all its turns before the next (its data stays in cache).
+    Returns the robots alive after each turn, summed (alive robot-turns).
+    """
+    n = rf.shape[2]
+    k = kf.shape[2]
+    x, y, h, gh, rh, energy = rf[:, K.X], rf[:, K.Y], rf[:, K.H], rf[:, K.GH], rf[:, K.RH], rf[:, K.E]
+    dist, body, gun, radar = rf[:, K.DIST], rf[:, K.BODYREM], rf[:, K.GUNREM], rf[:, K.RADREM]
+    maxv, assist, ev_robb, ev_bulb = rf[:, K.MAXV], rf[:, K.ASSIST], rf[:, K.EVROBB], rf[:, K.EVBULB]
+    alive, scan_req, ev_wall, ev_fault, ev_died = rb[:, K.ALIVE], rb[:, K.SCANREQ], rb[:, K.EVWALL], \
+        rb[:, K.EVFAULT], rb[:, K.EVDIED]
+    team, ev_robot, ev_hitby = ri[:, K.TEAM], ri[:, K.EVROBOT], ri[:, K.EVHITBY]
+    total = 0
+    for b in range(b0, b1):
+        for _ in range(turns):
+            if rounds[b] != bi[b, K.ROUND]:  # sync_rounds: a round started since the bots last acted
+                _clear_memory(mem, b)
+                rounds[b] = bi[b, K.ROUND]
+            for i in range(n):
+                if kinds[i] != K_NONE:
+                    for c in range(4):
+                        cmd[b, i, c] = math.nan
+                    cmd[b, i, 4] = 0.0
+            _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist, body, gun, radar, maxv, assist,
+                         scan_req, scanned, ev_wall, ev_robot, ev_robb, ev_fault, ev_hitby, ev_bulb, ev_died, width,
+                         height, cmd, rem)
+            if not bb[b, K.DONE]:
+                K.step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                                 placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
+            for i in range(n):
+                total += 1 if rb[b, K.ALIVE, i] else 0
+            if bb[b, K.DONE]:
+                K.reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
+                               params, fixed, has_fixed, scratch_i)
+    return total
 
 
 class ScriptedBots:
@@ -573,6 +634,34 @@ class ScriptedBots:
         else:
             self._run(0, cmd)
         return cmd
+
+    def play(self, turns: int, cmd: np.ndarray | None = None) -> int:
+        """``turns`` times ``commands(cmd)``, ``arena.step(cmd)``, ``arena.reset(done)``, in compiled code.
+
+        Gives the same states as that loop; battles run in parallel chunks, each its turns in a row. Robots
+        without a bot keep their rows of ``cmd`` (default: idle). Returns the robots alive after each turn,
+        summed over turns and battles (alive robot-turns).
+        """
+        if isinstance(turns, bool) or not isinstance(turns, int | np.integer) or turns < 0:
+            raise ValueError(f"turns must be a non-negative integer, got {turns!r}")
+        a = self.arena
+        if cmd is None:
+            cmd = a.idle_commands()
+        if cmd.shape != (a.n_battles, a.n_robots, 5) or cmd.dtype != np.float64 or not cmd.flags.c_contiguous:
+            raise ValueError(f"cmd must be a C-contiguous float64 array of shape ({a.n_battles}, {a.n_robots}, 5)")
+        head, (params, scratch_i, scratch_f) = a._args
+        sc = a.scenario
+        tail = (cmd, params, scratch_i, scratch_f, a._fixed, a._has_fixed, float(sc.width), float(sc.height))
+        nb, workers = a.n_battles, a.threads
+        size = -(-nb // workers) if nb >= 2 * workers and workers > 1 else nb
+        bounds = [(lo, min(nb, lo + size)) for lo in range(0, nb, size)]
+
+        def run(lo: int, hi: int) -> int:
+            return int(play_range(lo, hi, int(turns), self.kinds, self.mem, self._round, *head, *tail, np.zeros(4)))
+
+        if len(bounds) == 1:
+            return run(*bounds[0])
+        return sum(f.result() for f in [_pool(workers).submit(run, lo, hi) for lo, hi in bounds])
 
     def _chunk_args(self) -> None:
         """Argument tuples of bots_step per battle chunk (views of the arena state: built once)."""

@@ -4,14 +4,16 @@ Protocol v2, one line per message (UTF-8). Robot -> Python:
 - once per round and connection, JSON ``{"v": 2, "type": "hello", "token", "name", "team" (team-mates'
   names joined by ";"), "round", "rounds", "width", "height"}``;
 - in turns 1, 1 + EVERY, 1 + 2 EVERY, ... ``O ROUND TURN X Y HEADING GUN_HEADING RADAR_HEADING VELOCITY
-  ENERGY GUN_HEAT OTHERS DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS``: SCANS is the latest sighting of each
+  ENERGY GUN_HEAT OTHERS DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS<TAB>HISTORY``: SCANS is the latest sighting of each
   robot, joined by "|", each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``;
-  EVENTS a JSON list of the events since the last observation; TURN is the engine turn the answer takes
-  effect in;
-- ``E ROUND TIME HOW ENERGY DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US`` at death or round end: the
-  round's decisions, their summed round trips (robot sends .. reads the answer) and how many took over 1 ms,
-  the turns played and the robot's own time outside ``execute()`` (deciding and the controller).
-Python -> robot: ``OK 2 EVERY N`` after a valid hello, followed by N ``key value`` lines: the parameters of
+  EVENTS a JSON list of the events since the last observation; HISTORY (empty unless asked for) one
+  ``TIME;ENERGY;TARGET;TARGET_PREVIOUS;TARGET_ENERGY`` record per turn since the last observation, joined by
+  "|" (:class:`TurnEnergy`); TURN is the engine turn the answer takes effect in;
+- ``E ROUND TIME HOW ENERGY DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US<TAB>HISTORY`` at death or
+  round end: the round's decisions, their summed round trips (robot sends .. reads the answer) and how many
+  took over 1 ms, the turns played and the robot's own time outside ``execute()`` (deciding and the
+  controller), and the history records since the last observation.
+Python -> robot: ``OK 2 EVERY HISTORY(0/1) N`` after a valid hello, followed by N ``key value`` lines: the parameters of
 the fixed gun/radar controller (:class:`~confront.arena.control.ControlConfig`) that the robot then runs in
 Java every turn (N = 0: no controller, the answers' gun, radar and fire are used);
 ``A TURN AHEAD TURN GUN RADAR FIRE`` per observation (radians, + clockwise; ``NaN`` keeps the remaining
@@ -61,6 +63,18 @@ class Scan:
 
 
 @dataclass(frozen=True)
+class TurnEnergy:
+    """One turn's energies for the paper's per-turn reward (Eq. 35): own, and the target's (the nearest enemy
+    by last scans, "" if none) at the previous record and now."""
+
+    time: int
+    energy: float
+    target: str
+    target_previous: float
+    target_energy: float
+
+
+@dataclass(frozen=True)
 class Observation:
     """What a bridged tank knows when it decides the commands for engine turn ``turn``."""
 
@@ -82,6 +96,7 @@ class Observation:
     height: float
     scans: tuple[Scan, ...] = ()
     events: tuple[dict[str, Any], ...] = ()
+    history: tuple[TurnEnergy, ...] = ()  # with BridgeSettings.history: each turn since the last observation
 
     def enemies(self) -> tuple[Scan, ...]:
         """Scans of robots that are not team-mates."""
@@ -99,20 +114,25 @@ class BridgeSettings:
     ``every``: the robots ask in turns 1, 1 + every, ... (the paper's SMDP step T); the commands keep running
     in between. ``controller``: run this fixed gun/radar controller in Java every turn (PolicyModel's, the
     exported robot's), so a policy that decides only the move needs no round trip between decisions; None:
-    the policy's gun, radar and fire answers are used (and hold between decisions).
+    the policy's gun, radar and fire answers are used (and hold between decisions). ``history``: the robots
+    record every turn's energies (:class:`TurnEnergy`) and send them with the next observation
+    (``Observation.history``) and at death or round end, where the policy's ``end_episode(robot, round,
+    history)`` gets them (so per-turn rewards need no per-turn round trip).
     """
 
     every: int = 1
     controller: ControlConfig | None = None
+    history: bool = False
 
     def __post_init__(self) -> None:
         if self.every < 1:
             raise ValueError(f"every must be >= 1, got {self.every}")
 
     def hello_reply(self) -> str:
-        """``OK 2 EVERY N`` and the controller's N ``key value`` lines (the policy file's, export.py)."""
+        """``OK 2 EVERY HISTORY N`` and the controller's N ``key value`` lines (the policy file's, export.py)."""
         lines = controller_lines(self.controller) if self.controller is not None else []
-        return "".join(line + "\n" for line in [f"OK {PROTOCOL_VERSION} {self.every} {len(lines)}", *lines])
+        first = f"OK {PROTOCOL_VERSION} {self.every} {int(self.history)} {len(lines)}"
+        return "".join(line + "\n" for line in [first, *lines])
 
 
 def controller_lines(control: ControlConfig) -> list[str]:
@@ -174,7 +194,7 @@ def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
     """Validate one ``O ...`` line (from the robot introduced by ``hello``) into an :class:`Observation`."""
     parts = line.split("\t")
     head = parts[0].split(" ")
-    if len(parts) != 3 or head[0] != "O" or len(head) != _OBS_FIELDS:
+    if len(parts) != 4 or head[0] != "O" or len(head) != _OBS_FIELDS:
         raise ValueError(f"bad observation line: {line[:80]!r}")
     rnd, turn, others = int(head[1]), int(head[2]), int(head[11])
     x, y, heading, gun, radar, vel, energy, heat = _floats(head[3:11], "state value")
@@ -196,8 +216,20 @@ def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
         robot=hello["name"], teammates=team, round=rnd, turn=turn, x=x, y=y, heading=heading,
         gun_heading=gun, radar_heading=radar, velocity=vel, energy=energy, gun_heat=heat, others=others,
         distance_remaining=remaining, width=float(hello["width"]), height=float(hello["height"]),
-        scans=tuple(scans), events=events,
+        scans=tuple(scans), events=events, history=parse_history(parts[3]),
     )
+
+
+def parse_history(text: str) -> tuple[TurnEnergy, ...]:
+    """``TIME;ENERGY;TARGET;TARGET_PREVIOUS;TARGET_ENERGY`` records joined by "|" (empty: none)."""
+    out = []
+    for item in text.split("|") if text else ():
+        f = item.split(";")
+        if len(f) != 5:
+            raise ValueError(f"bad history record: {item[:80]!r}")
+        own, prev, now = _floats((f[1], f[3], f[4]), "history value")
+        out.append(TurnEnergy(int(f[0]), own, f[2], prev, now))
+    return tuple(out)
 
 
 def format_observation(obs: Observation) -> str:
@@ -209,7 +241,10 @@ def format_observation(obs: Observation) -> str:
                  + [repr(v) for v in (s.bearing, s.distance, s.heading, s.velocity, s.energy, s.x, s.y)])
         for s in obs.scans
     )
-    return "O " + " ".join(repr(v) for v in head) + "\t" + scans + "\t" + json.dumps(list(obs.events))
+    history = "|".join(f"{h.time};{h.energy!r};{h.target};{h.target_previous!r};{h.target_energy!r}"
+                       for h in obs.history)
+    return ("O " + " ".join(repr(v) for v in head) + "\t" + scans + "\t" + json.dumps(list(obs.events)) + "\t"
+            + history)
 
 
 def format_action(turn: int, action: Action) -> str:
@@ -335,14 +370,18 @@ class BridgeServer:
                             self.on_hello(hello)
                         sock.sendall(self._reply)
                     elif line.startswith("E "):
-                        parts = line.split(" ")
-                        if len(parts) != 10:
+                        tab = line.split("\t")
+                        parts = tab[0].split(" ")
+                        if len(parts) != 10 or len(tab) != 2:
                             raise ValueError(f"bad end line: {line[:80]!r}")
+                        history = parse_history(tab[1])
                         with self._lock:
                             self.stats.rounds_ended += 1
                             self.stats.add_round_end(parts[5:])
                             end = getattr(self.policy, "end_episode", None)
-                            if end is not None:  # e.g. a learner's last SMDP step of the round
+                            if end is not None and self.settings.history:
+                                end(hello["name"], int(parts[1]), history)
+                            elif end is not None:  # e.g. a learner's last SMDP step of the round
                                 end(hello["name"], int(parts[1]))
                     else:
                         t0 = time.perf_counter()

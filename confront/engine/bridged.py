@@ -76,18 +76,20 @@ def run_bridged_battle(
     every: int = 1,
     extra_robots: Sequence[str | os.PathLike[str]] = (),
     controller: ControlConfig | None = None,
+    history: bool = False,
 ) -> BridgedRun:
     """Run ``spec`` (whose contestants include BridgeBot tanks) with ``policy`` deciding for every BridgeBot.
 
     The robots connect before their first action and ask ``policy`` in turns 1, 1 + every, ... (the paper's
     SMDP step T); the commands keep running in between. ``controller``: the robots run this fixed gun/radar
     controller themselves every turn (the answers' gun, radar and fire are then ignored), so a policy that
-    only picks moves costs one round trip per ``every`` turns. ``extra_robots``: robot jars or folders to add
+    only picks moves costs one round trip per ``every`` turns. ``history``: the robots send every turn's energies
+with the next observation and at the round's end (``BridgeSettings``). ``extra_robots``: robot jars or folders to add
     (e.g. exported PolicyBot opponents).
     """
     opts = options or EngineOptions(cpu_constant_ms=BRIDGE_CPU_CONSTANT_MS)
     tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)
-    with BridgeServer(policy, settings=BridgeSettings(every, controller)) as server:
+    with BridgeServer(policy, settings=BridgeSettings(every, controller, history)) as server:
         run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo), workdir=workdir,
                          extra_robots=extra_robots)
     st = server.stats

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from confront.engine.battle import BattleSpec, scenario_battle
-from confront.engine.bridge import Observation, nearest_enemy_policy
+from confront.engine.bridge import Observation, TurnEnergy, nearest_enemy_policy
 from confront.engine.bridged import BRIDGE_BOT, bridge_failures, bridge_options, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.runner import EngineOptions, run_battle
@@ -121,3 +121,37 @@ def test_java_controller_between_decisions_plays_like_the_exported_robot(install
         assert res.run.round_turns == java.round_turns
         assert [(c.name.startswith("sample."), c.total) for c in res.run.results.contestants] == [
             (c.name.startswith("sample."), c.total) for c in java.results.contestants]
+
+
+def test_history_brings_every_turn_between_decisions(install) -> None:
+    """history=True: each turn's energies arrive once, with the next observation or at the round's end."""
+    policy = ExportedPolicy("qtable", q=np.random.default_rng(5).normal(size=(320, 4)), step_turns=5)
+    records: dict[int, list[TurnEnergy]] = {}
+    ends: list[tuple[int, int]] = []
+
+    class Recording:
+        def __call__(self, obs: Observation):
+            assert obs.history[-1].time == obs.turn - 1 and obs.history[-1].energy == obs.energy
+            records.setdefault(obs.round, []).extend(obs.history)
+            return policy(obs)
+
+        def end_episode(self, robot: str, round_: int, history: tuple[TurnEnergy, ...]) -> None:
+            ends.append((round_, len(history)))
+            records.setdefault(round_, []).extend(history)
+
+    opts = EngineOptions(seed=3, cpu_constant_ms=50)
+    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SpinBot"), rounds=2), Recording(), opts, every=5,
+                             controller=policy.control, history=True)
+    assert res.ok, (res.failures, res.server_errors)
+    assert [r for r, _ in ends] == [0, 1] and all(n >= 1 for _, n in ends)
+    for hs in records.values():
+        times = [h.time for h in hs]
+        assert times[0] == 0 and all(b > a for a, b in zip(times, times[1:], strict=False))
+        if not res.run.skipped_turns:
+            assert times == list(range(len(times)))  # every turn exactly once
+        assert hs[0].energy == 100.0 and hs[0].target == ""  # nothing scanned before turn 1
+        assert hs[20].target == "sample.SpinBot"  # scanned within 20 turns: the only enemy
+        assert {h.target for h in hs} == {"", "sample.SpinBot"}
+        for a, b in zip(hs, hs[1:], strict=False):
+            if a.target == b.target != "":
+                assert b.target_previous == a.target_energy  # consecutive records chain

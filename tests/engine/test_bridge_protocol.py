@@ -15,7 +15,9 @@ from confront.engine.bridge import (
     BridgeServer,
     BridgeSettings,
     Observation,
+    TurnEnergy,
     format_action,
+    format_observation,
     load_policy,
     nearest_enemy_policy,
     parse_hello,
@@ -29,8 +31,8 @@ SCAN_MATE = "confront.BridgeBot* (2);5;1;0.1;50.0;2.0;0.0;100.0;105.0;250.0"
 
 
 def obs_line(turn: int = 7, heat: float = 2.3, scans: str = f"{SCAN_WALLS}|{SCAN_MATE}",
-             events: str = '[{"type":"hit_wall"}]') -> str:
-    return f"O 0 {turn} 100.0 200.0 0.0 0.5 1.0 8.0 99.5 {heat} 2 12.0\t{scans}\t{events}"
+             events: str = '[{"type":"hit_wall"}]', history: str = "") -> str:
+    return f"O 0 {turn} 100.0 200.0 0.0 0.5 1.0 8.0 99.5 {heat} 2 12.0\t{scans}\t{events}\t{history}"
 
 
 def test_parse_observation_values() -> None:
@@ -39,7 +41,14 @@ def test_parse_observation_values() -> None:
                                                                 ("confront.BridgeBot* (2)",), 7, 2)
     assert (obs.x, obs.y, obs.energy, obs.gun_heat, obs.width) == (100.0, 200.0, 99.5, 2.3, 800.0)
     assert [s.name for s in obs.enemies()] == ["sample.Walls"]
-    assert obs.events == ({"type": "hit_wall"},)
+    assert obs.events == ({"type": "hit_wall"},) and obs.history == ()
+
+
+def test_history_records_round_trip() -> None:
+    line = obs_line(history="5;99.5;sample.Walls;80.0;77.0|6;97.25;;0.0;0.0")
+    obs = parse_observation(line, HELLO)
+    assert obs.history == (TurnEnergy(5, 99.5, "sample.Walls", 80.0, 77.0), TurnEnergy(6, 97.25, "", 0.0, 0.0))
+    assert parse_observation(format_observation(obs), HELLO) == obs
 
 
 @pytest.mark.parametrize(
@@ -53,6 +62,9 @@ def test_parse_observation_values() -> None:
         obs_line(scans="sample.Walls;6;0;0.5"),
         obs_line(events='{"type":"x"}'),
         obs_line().split("\t")[0],
+        obs_line().rsplit("\t", 1)[0],
+        obs_line(history="5;99.5;sample.Walls;80.0"),
+        obs_line(history="5;inf;sample.Walls;80.0;77.0"),
     ],
 )
 def test_bad_observations_rejected(line: str) -> None:
@@ -68,11 +80,12 @@ def test_bad_hello_rejected() -> None:
 
 
 def test_hello_reply_carries_interval_and_controller() -> None:
-    assert BridgeSettings().hello_reply() == "OK 2 1 0\n"
+    assert BridgeSettings().hello_reply() == "OK 2 1 0 0\n"
+    assert BridgeSettings(4, history=True).hello_reply() == "OK 2 4 1 0\n"
     ctl = ControlConfig(power_near=2.5, fire=False)
     lines = BridgeSettings(10, ctl).hello_reply().splitlines()
     n = len(fields(ControlConfig))
-    assert lines[0] == f"OK 2 10 {n}" and len(lines) == n + 1
+    assert lines[0] == f"OK 2 10 0 {n}" and len(lines) == n + 1
     assert "power_near 2.5" in lines and "fire 0" in lines and "near_distance 150.0" in lines
     assert f"turn_angle {math.radians(45.0)!r}" in lines
     with pytest.raises(ValueError, match="every"):
@@ -122,10 +135,10 @@ def test_server_round_trip_on_loopback() -> None:
         assert server.port > 0
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps(HELLO) + "\n").encode())
-            assert _lines(s, 1) == ["OK 2 5 0"]
+            assert _lines(s, 1) == ["OK 2 5 0 0"]
             s.sendall((obs_line() + "\n" + obs_line(turn=8, scans="", events="[]") + "\n").encode())
             assert _lines(s, 2) == ["A 7 7.0 NaN 0.0 0.0 1.5", "A 8 8.0 NaN 0.0 0.0 1.5"]
-            s.sendall(b"E 0 9 death 0.0 2 300 1 9 450\n")
+            s.sendall(b"E 0 9 death 0.0 2 300 1 9 450\t9;0.0;sample.Walls;50.0;50.0\n")
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps({**HELLO, "token": "bad"}) + "\n").encode())
             assert _lines(s, 1) == []  # closed without an answer

@@ -9,6 +9,7 @@ import java.net.InetAddress;
 import java.net.InetSocketAddress;
 import java.net.Socket;
 import java.nio.charset.StandardCharsets;
+import java.util.HashMap;
 import java.util.LinkedHashMap;
 import java.util.Map;
 
@@ -30,7 +31,8 @@ import robocode.util.Utils;
  * Settings come from JVM system properties (the engine runs with -DNOSECURITY=true so that robots may use
  * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs. Protocol version 2
  * (format in confront/engine/bridge.py), one line per message: the robot sends a JSON "hello" once per round
- * and Python answers "OK 2 EVERY N" plus N "key value" lines of the fixed gun/radar controller (N = 0: none).
+ * and Python answers "OK 2 EVERY HISTORY N" plus N "key value" lines of the fixed gun/radar controller (N = 0:
+ * none); with HISTORY = 1 the robot records every turn's energies and sends them with the next message.
  * The robot then sends an "O ..." observation in turns 1, 1 + EVERY, 1 + 2 EVERY, ... and "E ..." at death
  * or round end; Python answers each observation with "A TURN AHEAD TURN GUN RADAR FIRE" (radians,
  * + clockwise; "NaN" keeps the current remaining value; fire 0 = no shot). Between decisions the commands keep
@@ -48,7 +50,11 @@ public class BridgeBot extends TeamRobot {
     private boolean failed;
     private boolean finished;
     private int every = 1;
+    private boolean keepHistory;
     private PolicyModel controller;
+    // per turn since the last message: TIME;OWN_ENERGY;TARGET;TARGET_PREVIOUS_ENERGY;TARGET_ENERGY, joined by "|"
+    private final StringBuilder history = new StringBuilder();
+    private Map<String, Double> lastEnergies = new HashMap<>();
     private long rttN;
     private long rttSum;
     private long rttSlow;
@@ -73,6 +79,9 @@ public class BridgeBot extends TeamRobot {
         while (true) {
             long t0 = System.nanoTime();
             long turn = getTime() + 1;  // the commands set now take effect in this engine turn
+            if (keepHistory && !failed && !finished) {
+                record();
+            }
             if (!failed && !finished && (turn - 1) % every == 0) {
                 try {
                     decide(turn);
@@ -111,13 +120,14 @@ public class BridgeBot extends TeamRobot {
                     + ",\"width\":" + getBattleFieldWidth() + ",\"height\":" + getBattleFieldHeight() + "}");
             String reply = in.readLine();
             String[] p = reply == null ? new String[0] : reply.split(" ");
-            if (p.length != 4 || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
+            if (p.length != 5 || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
                 fail("bad hello reply " + reply);
                 return;
             }
             every = Integer.parseInt(p[2]);
-            int n = Integer.parseInt(p[3]);
-            if (every < 1 || n < 0 || n > 100) {
+            keepHistory = p[3].equals("1");
+            int n = Integer.parseInt(p[4]);
+            if (every < 1 || !(p[3].equals("0") || keepHistory) || n < 0 || n > 100) {
                 fail("bad hello reply " + reply);
                 return;
             }
@@ -169,8 +179,9 @@ public class BridgeBot extends TeamRobot {
                 b.append(';').append(s[i]);
             }
         }
-        b.append("\t[").append(events).append("]\n");
+        b.append("\t[").append(events).append("]\t").append(history).append('\n');
         events.setLength(0);
+        history.setLength(0);
         long t0 = System.nanoTime();
         out2.write(b.toString().getBytes(StandardCharsets.UTF_8));
         out2.flush();
@@ -213,6 +224,38 @@ public class BridgeBot extends TeamRobot {
         if (!Double.isNaN(a[4]) && a[4] > 0) {
             setFire(a[4]);
         }
+    }
+
+    /**
+     * This turn's own energy and its target's (the nearest enemy by last scans, as the controller picks it)
+     * energy now and at the previous record, for the paper's per-turn reward (Eq. 35) between decisions.
+     */
+    private void record() {
+        int n = enemies.size();
+        double[] ex = new double[n];
+        double[] ey = new double[n];
+        String[] names = new String[n];
+        Map<String, Double> now = new HashMap<>();
+        int i = 0;
+        for (Map.Entry<String, double[]> e : enemies.entrySet()) {
+            names[i] = e.getKey();
+            ex[i] = e.getValue()[0];
+            ey[i] = e.getValue()[1];
+            now.put(e.getKey(), e.getValue()[2]);
+            i++;
+        }
+        int t = PolicyModel.nearest(getX(), getY(), ex, ey);
+        if (history.length() > 0) {
+            history.append('|');
+        }
+        history.append(getTime()).append(';').append(getEnergy()).append(';');
+        if (t >= 0) {
+            double e = now.get(names[t]);
+            history.append(names[t]).append(';').append(lastEnergies.getOrDefault(names[t], e)).append(';').append(e);
+        } else {
+            history.append(";0.0;0.0");
+        }
+        lastEnergies = now;
     }
 
     /** The fixed gun/radar controller on the enemies' last scans, as PolicyBot runs it every turn. */
@@ -335,8 +378,11 @@ public class BridgeBot extends TeamRobot {
         if (!failed && socket != null) {
             try {
                 // with this round's round-trip and work-time statistics (a dead robot's output is not collected)
+                if (keepHistory) {
+                    record();  // the state this robot ends the round in
+                }
                 send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy() + " " + rttN + " "
-                        + rttSum / 1000 + " " + rttSlow + " " + turnsPlayed + " " + workNanos / 1000);
+                        + rttSum / 1000 + " " + rttSlow + " " + turnsPlayed + " " + workNanos / 1000 + "\t" + history);
             } catch (IOException e) {
                 // the round is over anyway
             }

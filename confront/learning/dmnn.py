@@ -47,6 +47,7 @@ __all__ = [
 OUTPUTS = ("linear", "bipolar")
 OBSERVATIONS = ("features", "discrete")
 DTYPES = ("float64", "float32")
+UNITS = ("q", "network")  # Q in reward units, or the network's own output units y = Q / q_scale
 
 
 def bipolar(x: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -130,6 +131,8 @@ class DMNNParams(LearnerParams):
     output: str = "linear"
     q_scale: float = 10.0
     td_clip: float = 5.0
+    rate_units: str = "network"
+    softmax_units: str = "q"
     gamma: float = 0.9
     alpha: float = 0.1
     rate: str = "fixed"
@@ -161,6 +164,8 @@ class DMNNParams(LearnerParams):
         check_choice("output", self.output, OUTPUTS)
         check_range("q_scale", self.q_scale, 0.0, 1e12, lo_open=True)
         check_range("td_clip", self.td_clip, 0.0, 1e12)
+        check_choice("rate_units", self.rate_units, UNITS)
+        check_choice("softmax_units", self.softmax_units, UNITS)
         check_range("gamma", self.gamma, 0.0, 1.0)
         check_range("alpha", self.alpha, 0.0, 1.0, lo_open=True)
         check_choice("rate", self.rate, RATES)
@@ -224,7 +229,11 @@ class DMNN(Learner):
 
     def act(self, obs: np.ndarray, rng: np.random.Generator, explore: bool = True) -> np.ndarray:
         # Eq. 30-31: softmax layer over the Q outputs at the annealed temperature
-        return select_actions(self._explore, self.q_values(obs), self.step, rng, explore)
+        return select_actions(self._explore, self.softmax_input(self.q_values(obs)), self.step, rng, explore)
+
+    def softmax_input(self, q: np.ndarray) -> np.ndarray:
+        """What the softmax layer's temperature divides: Q, or the network outputs Q / q_scale."""
+        return q / self.params.q_scale if self.params.softmax_units == "network" else q
 
     def learning_rate(self, rewards: np.ndarray) -> np.ndarray:
         """Per-transition RL rate: fixed alpha, or the fuzzy map of the SMDP step's summed reward."""
@@ -235,7 +244,8 @@ class DMNN(Learner):
     def targets(self, batch: Transition) -> np.ndarray:
         """Backup targets (reward units) from the current network."""
         q_next = self.q_values(batch.next_obs)
-        probs = policy_probs(self._explore, q_next, self.step) if self.params.bootstrap == "expected" else None
+        expected = self.params.bootstrap == "expected"
+        probs = policy_probs(self._explore, self.softmax_input(q_next), self.step) if expected else None
         v = bootstrap_values(q_next, probs, batch.done)
         return smdp_target(batch.rewards, v, self.params.gamma, self.params.backup)
 
@@ -255,7 +265,8 @@ class DMNN(Learner):
         phi = alpha * clipped  # Eq. 32: phi_t = Q_next - Q_cur = alpha [target - Q_cur]
         e_p = 0.5 * phi * phi  # Eq. 21: E_p = (O - y)^2 / 2 with the label O = Q_cur + phi
         if p.awm:
-            lam = 1.0 - np.exp(-e_p)  # Eq. 24: adaptive rate 1 - exp(-E_p)
+            e_rate = e_p * p.q_scale**2 if p.rate_units == "q" else e_p  # E_p of phi in Q units, or network units
+            lam = 1.0 - np.exp(-e_rate)  # Eq. 24: adaptive rate 1 - exp(-E_p)
         else:
             lam = np.full(n, p.nn_rate)
         labels = acts[-1][rows, a] + phi  # Eq. 18: Q_cur* = (1 - alpha) Q_cur + alpha target

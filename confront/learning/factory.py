@@ -14,6 +14,7 @@ from confront.learning.dmnn import DMNN, DMNNParams
 from confront.learning.fuzzy import FuzzyParams
 from confront.learning.tabular import TabularParams, TabularQ
 from confront.learning.transfer import Frozen, TransferParams, TransferPolicy
+from confront.learning.uniform import UniformParams, UniformPolicy
 
 __all__ = ["KINDS", "clone_learner", "load_learner", "make_learner", "save_learner", "transfer_from"]
 
@@ -25,12 +26,13 @@ KINDS: dict[str, tuple[type, dict[str, Any], Callable[..., Learner]]] = {
     "qlearning_egreedy": (TabularParams, _TD, TabularQ),
     "qlearning_dgreedy": (TabularParams, {**_TD, "exploration": "degreedy"}, TabularQ),
     "dmnn": (DMNNParams, {}, DMNN),
+    "random": (UniformParams, {}, UniformPolicy),
 }
 
 
 def make_learner(kind: str, *, rng: np.random.Generator | None = None, fuzzy: dict[str, Any] | None = None,
                  **params: Any) -> Learner:
-    """A new learner of ``kind`` (ssaq, qlearning_egreedy, qlearning_dgreedy, dmnn) with ``params`` overriding
+    """A new learner of ``kind`` (ssaq, qlearning_egreedy, qlearning_dgreedy, dmnn, random) with ``params`` overriding
     the kind's preset; ``fuzzy`` overrides the fuzzy rate's settings; ``rng`` initialises a network's weights."""
     if kind not in KINDS:
         raise ValueError(f"bad value kind={kind!r}: must be one of {', '.join(KINDS)}")
@@ -39,6 +41,8 @@ def make_learner(kind: str, *, rng: np.random.Generator | None = None, fuzzy: di
     fz = params_from_dict(FuzzyParams, fuzzy) if fuzzy else None  # type: ignore[arg-type]
     if ctor is DMNN:
         return DMNN(p, rng=rng, fuzzy=fz, kind=kind)  # type: ignore[arg-type]
+    if ctor is UniformPolicy:
+        return UniformPolicy(p, kind=kind)  # type: ignore[arg-type]
     return ctor(p, fuzzy=fz, kind=kind)
 
 

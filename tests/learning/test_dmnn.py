@@ -216,3 +216,42 @@ def test_non_finite_update_raises_and_keeps_weights():
     with pytest.raises(FloatingPointError, match="unchanged"), np.errstate(all="ignore"):
         net.learn(Transition(x, np.array([0, 1]), np.full((2, 1), 1e300), x, np.ones(2, dtype=bool)))
     assert all(np.array_equal(a, b) for a, b in zip(before, net.weights, strict=True))
+
+
+def _rate_of_one_update(q_scale, units):
+    net = make_learner("dmnn", n_inputs=1, n_actions=1, hidden=(2,), alpha=0.5, q_scale=q_scale, td_clip=0.0,
+                       rate_units=units)
+    net.weights[-1][:] = 0.0
+    net.biases[-1][:] = 0.0
+    x = np.zeros((1, 1))
+    return net.learn(Transition(x, np.array([0]), np.array([[10.0]]), x, np.array([True])))["nn_rate"]
+
+
+def test_adaptive_rate_units():
+    # TD error 10 in Q units from Q = 0, alpha 0.5. Default ("network", Eq. 22 on the network's output error):
+    # phi = 0.5 * 10 / q_scale, so with q_scale 10 E = 0.125. "q": phi = 5 whatever q_scale, E = 12.5.
+    assert _rate_of_one_update(10.0, "network") == pytest.approx(1 - np.exp(-0.125))
+    assert _rate_of_one_update(1.0, "network") == pytest.approx(1 - np.exp(-12.5))
+    assert _rate_of_one_update(10.0, "q") == pytest.approx(1 - np.exp(-12.5))
+    assert make_learner("dmnn").params.rate_units == "network"
+    with pytest.raises(ValueError, match="rate_units"):
+        make_learner("dmnn", rate_units="reward")
+
+
+def test_softmax_units_choose_what_the_temperature_divides():
+    # Q(s', .) = (0, 10) in Q units, i.e. (0, 1) network outputs with q_scale 10; T = 0.5 (t_max, step 0).
+    # Expected bootstrap (Eq. 9), T = 1 reward column of 0, gamma 1, paper backup: target = sum_a pi(a) Q(a).
+    def target(units):
+        net = make_learner("dmnn", n_inputs=1, n_actions=2, hidden=(2,), q_scale=10.0, t_max=0.5, t_min=0.1,
+                           gamma=1.0, softmax_units=units)
+        net.weights[-1][:] = 0.0
+        net.biases[-1][:] = [0.0, 1.0]
+        x = np.zeros((1, 1))
+        return net.targets(Transition(x, np.array([0]), np.zeros((1, 1)), x, np.array([False])))[0]
+
+    p_net = np.exp(1 / 0.5) / (1 + np.exp(1 / 0.5))  # softmax of (0, 1) / 0.5
+    p_q = np.exp(10 / 0.5) / (1 + np.exp(10 / 0.5))  # softmax of (0, 10) / 0.5
+    assert target("network") == pytest.approx(10 * p_net)
+    assert target("q") == pytest.approx(10 * p_q)
+    with pytest.raises(ValueError, match="softmax_units"):
+        make_learner("dmnn", softmax_units="reward")

@@ -1,0 +1,147 @@
+"""Do our learners learn in the battle? Learning curves of several arms against the frozen TD team (4v4).
+
+Arms (each trained, or just played, for ``--rounds`` rounds per seed in the same battles as ``confront train``):
+
+- ``dmnn``: the ``awm`` experiment's DMNN (as configured, plus any ``--set`` overrides),
+- ``random``: uniform random macro moves (same gun/radar controller),
+- ``frozen``: the same DMNN at its initial weights, greedy, never learning,
+- ``td``: a fresh copy of the TD team's own tabular learner (epsilon-greedy Q-learning) on our side,
+- ``ssaq``: tabular SSAQ,
+- ``mirror``: the trained TD team itself on our side, greedy (a symmetry check: about 0.5).
+
+Prints the mean score ratio per block of rounds (sessions of 10 pooled into ``--blocks`` blocks) with a 95%
+t-interval over seeds, and the first-vs-last block difference. Set ``CONFRONT_CACHE`` to a scratch folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from scipy import stats  # noqa: E402
+
+ARMS = ("dmnn", "random", "frozen", "td", "ssaq", "mirror")
+
+
+def parse_value(text: str) -> object:
+    """A learner parameter value from the command line: bool, int, float or string."""
+    if text in ("true", "false"):
+        return text == "true"
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
+            learner_params: tuple[tuple[str, object], ...] = ()) -> np.ndarray:
+    """(2, rounds // 10): per session of one arm at one seed, the score ratio and our tanks' mean Eq. 35 reward
+    per SMDP step; ``learner_params`` rebuild the DMNN."""
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import _run, _setup, session_rows, td_learner
+    from confront.learning.factory import clone_learner, make_learner
+    from confront.learning.transfer import Frozen
+
+    sets = [f"train.seed={seed}", f"train.rounds={rounds}", "train.replay=false", *overrides]
+    if arm == "ssaq":
+        sets.append("learner.kind=ssaq")
+    cfg = load_experiment("awm", sets)
+    loop, _ = _setup(cfg, progress=False)
+    n_actions = loop.env.n_actions
+    if learner_params and arm in ("dmnn", "frozen"):
+        lr = loop.side.learner
+        loop.side.learner = make_learner(lr.kind, **{**lr.params.to_dict(), **dict(learner_params)})
+    if arm == "random":
+        loop.side.learner = make_learner("random", n_actions=n_actions)
+    elif arm == "frozen":
+        loop.learning = False
+    elif arm == "td":
+        loop.side.learner = td_learner(cfg, n_actions)
+    elif arm == "mirror":
+        assert loop.side.opponent is not None
+        opp = loop.side.opponent
+        loop.side.learner = Frozen(clone_learner(opp.inner if isinstance(opp, Frozen) else opp))
+        loop.learning = False
+    sessions = rounds // 10
+    reward = np.zeros((2, sessions))  # per session of rounds: summed Eq. 35 reward of our tanks, tank-steps
+    env_step = loop.env.step
+
+    def step(actions: np.ndarray):  # noqa: ANN202 - records our tanks' rewards per session, then steps
+        res = env_step(actions)
+        ours = res.active & loop.side.ours[None, :]
+        k = min(loop.rounds_done // 10, sessions - 1)
+        reward[0, k] += res.rewards.sum(axis=2)[ours].sum()
+        reward[1, k] += ours.sum()
+        return res
+
+    loop.env.step = step  # type: ignore[method-assign]
+    _run(loop, rounds, progress=False, desc=arm)
+    ratio = np.array([s["score_ratio"] for s in session_rows(loop.rows[:rounds], 10)])
+    return np.stack([ratio, reward[0] / np.maximum(reward[1], 1)])
+
+
+def interval(values: np.ndarray) -> tuple[float, float, float]:
+    """Mean and 95% t-interval over seeds."""
+    m = float(values.mean())
+    if len(values) < 2:
+        return m, m, m
+    h = float(stats.t.ppf(0.975, len(values) - 1) * values.std(ddof=1) / np.sqrt(len(values)))
+    return m, m - h, m + h
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--arms", default=",".join(ARMS), help="comma-separated subset of " + ", ".join(ARMS))
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--rounds", type=int, default=500)
+    ap.add_argument("--blocks", type=int, default=5, help="blocks of rounds in the table")
+    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--set", dest="sets", action="append", default=[], help="config override for every arm")
+    ap.add_argument("--learner", action="append", default=[],
+                    help="KEY=VALUE: a DMNN parameter beyond the config (e.g. rate_units=network)")
+    args = ap.parse_args()
+    arms = [a for a in args.arms.split(",") if a]
+    for a in arms:
+        if a not in ARMS:
+            raise SystemExit(f"unknown arm {a!r}: use {', '.join(ARMS)}")
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    extra = tuple((k, parse_value(v)) for k, _, v in (t.partition("=") for t in args.learner))
+    jobs = [(a, s) for a in arms for s in seeds]
+    t0 = time.time()
+    with ProcessPoolExecutor(args.workers) as pool:
+        futs = {job: pool.submit(run_arm, job[0], job[1], args.rounds, tuple(args.sets), extra) for job in jobs}
+        curves = {job: f.result() for job, f in futs.items()}
+    n_sess = args.rounds // 10
+    edges = np.linspace(0, n_sess, args.blocks + 1).astype(int)
+    heads = [f"rounds {10 * lo + 1}-{10 * hi}" for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
+    print(f"\n{len(list(seeds))} seeds x {args.rounds} rounds, overrides {args.sets + args.learner or 'none'}, "
+          f"{time.time() - t0:.0f} s; mean [95% t-interval over seeds]")
+    for row, what in ((0, "score ratio"), (1, "mean Eq. 35 reward per tank and SMDP step")):
+        print(f"\n{what}\n")
+        table(arms, seeds, curves, row, edges, heads)
+
+
+def table(arms: list[str], seeds: range, curves: dict, row: int, edges: np.ndarray, heads: list[str]) -> None:
+    """One markdown table: arms x blocks of rounds, mean [95% t-interval over seeds]."""
+    print("| arm | " + " | ".join(heads) + " | last - first block |")
+    print("|---|" + "---|" * (len(heads) + 1))
+    for a in arms:
+        per_seed = np.stack([curves[(a, s)][row] for s in seeds])  # (S, sessions)
+        blocks = np.stack([per_seed[:, lo:hi].mean(axis=1) for lo, hi in zip(edges[:-1], edges[1:], strict=True)],
+                          axis=1)
+        cells = ["{:.3f} [{:.3f}, {:.3f}]".format(*interval(blocks[:, k])) for k in range(blocks.shape[1])]
+        diff = "{:+.3f} [{:+.3f}, {:+.3f}]".format(*interval(blocks[:, -1] - blocks[:, 0]))
+        print(f"| {a} | " + " | ".join(cells) + f" | {diff} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -7,8 +7,8 @@ Methods, all playing the paper's 4v4 scenario as team 0:
   :class:`~confront.arena.smdp.TeamBattleEnv`; needs the extra ``confront[baselines]``;
 - ``DMNN (FLM)``: the paper's method, trained by :func:`~confront.experiments.train.train_run`;
 - the scripted sample robots SpinBot, Walls, Tracker and RamFire as our team (no training);
-- references that tell whether training helps: ``Random moves`` (each tank picks one of the four moves
-  uniformly at random every SMDP step, with the same gun/radar controller) and ``DMNN (untrained)`` (the
+- references that tell whether training helps: ``Random moves`` (``UniformPolicy``: each tank picks one of the
+  four moves uniformly at random every SMDP step, same gun/radar controller) and ``DMNN (untrained)`` (the
   DMNN of the seed at its initialisation, greedy).
 
 Trained methods learn against the TD team (the paper's opponent, ``train.td_team`` artefact of the seed)
@@ -39,6 +39,7 @@ from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.experiments.reproduce import Claim, Job, Outcome, run_jobs, slug
 from confront.experiments.stats import Interval, interval
 from confront.learning.base import Learner, Transition
+from confront.learning.uniform import UniformParams, UniformPolicy
 
 try:  # the optional extra confront[baselines]
     from stable_baselines3.common.vec_env.base_vec_env import VecEnv as _VecEnvBase
@@ -48,7 +49,7 @@ except ImportError:  # the core install runs the scripted and paper methods only
     _VecEnvBase = object  # type: ignore[assignment,misc]
     HAVE_SB3 = False
 
-__all__ = ["BaselinesConfig", "SharedTeamVecEnv", "SB3Policy", "RandomMoves", "baselines_outcome", "train_sb3",
+__all__ = ["BaselinesConfig", "SharedTeamVecEnv", "SB3Policy", "baselines_outcome", "train_sb3",
            "rank_table", "HAVE_SB3"]
 
 SB3_METHODS = ("DQN", "PPO")
@@ -265,38 +266,6 @@ class SB3Policy(Learner):
         self.model.policy.load_state_dict({k: torch.as_tensor(state[k]) for k in own})
 
 
-class RandomMoves(Learner):
-    """Reference policy: one of ``n_actions`` moves uniformly at random per decision, exploring or not."""
-
-    kind = "random"
-    observation = "discrete"
-
-    def __init__(self, n_actions: int) -> None:
-        if n_actions < 1:
-            raise ValueError(f"n_actions must be >= 1, got {n_actions}")
-        self.n_actions = n_actions
-        self.params = None
-
-    def act(self, obs: np.ndarray, rng: np.random.Generator, explore: bool = True) -> np.ndarray:
-        """Uniform random actions, one per observation."""
-        return rng.integers(0, self.n_actions, size=len(np.asarray(obs)))
-
-    def learn(self, batch: Transition) -> dict[str, float]:
-        """Nothing to learn."""
-        return {}
-
-    def diagnostics(self) -> dict[str, float]:
-        """Nothing to report."""
-        return {}
-
-    def state_dict(self) -> dict[str, np.ndarray]:
-        """No parameters."""
-        return {}
-
-    def load_state_dict(self, state: dict[str, np.ndarray]) -> None:
-        """No parameters."""
-
-
 # -- one (method, seed) ------------------------------------------------------------------------------------------
 
 def _experiment(cfg: BaselinesConfig, seed: int, rounds: int) -> Any:
@@ -417,7 +386,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
         smdp = smdp_config(exp)
         _, td_path = td_team(exp, smdp.n_actions)
         if method == RANDOM_METHOD:
-            policy = RandomMoves(smdp.n_actions)
+            policy = UniformPolicy(UniformParams(n_actions=smdp.n_actions))
         elif method == UNTRAINED_METHOD:
             policy = build_learner(exp, smdp.observation.n_features, smdp.n_actions)
         else:

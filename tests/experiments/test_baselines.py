@@ -10,7 +10,7 @@ import pytest
 
 from confront.arena.scenarios import get_scenario
 from confront.arena.smdp import TeamBattleEnv
-from confront.experiments.baselines import HAVE_SB3, BaselinesConfig, RandomMoves, baselines_outcome, rank_table
+from confront.experiments.baselines import HAVE_SB3, BaselinesConfig, baselines_outcome, rank_table
 from confront.learning.tabular import TabularParams, TabularQ
 
 B = 2  # battles
@@ -44,17 +44,6 @@ def test_config_rejects_bad_values() -> None:
         BaselinesConfig(references=("Oracle",))
     with pytest.raises(ValueError, match="'Sitter'"):
         BaselinesConfig(scripted=("Sitter",))
-
-
-def test_random_moves_are_uniform_and_ignore_exploration() -> None:
-    policy = RandomMoves(4)
-    a = policy.act(np.zeros(40_000, dtype=np.int64), np.random.default_rng(0), explore=False)
-    counts = np.bincount(a, minlength=4)
-    assert a.shape == (40_000,) and counts.sum() == 40_000
-    assert np.all(np.abs(counts / 40_000 - 0.25) < 0.01)  # 4 standard errors at n = 40 000 is 0.0087
-    assert policy.state_dict() == {} and policy.learn(None) == {}  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="n_actions"):
-        RandomMoves(0)
 
 
 def test_rank_table_orders_by_first_opponent_and_lists_skipped() -> None:

@@ -67,17 +67,35 @@ def exported_policy(learner: Learner, cfg: ExperimentConfig) -> Any:
                                        step_turns=cfg.arena.decision_turns)
 
 
-def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int) -> None:
+SIM_SEEDS = 5  # simulator seeds per opponent: the simulator is cheap, and their spread shows a ratio's noise
+
+
+def sim_ratios(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seeds: range,
+               td_model: str | None = None) -> list[float]:
+    """Our score ratio in the simulator against ``opponent`` over ``rounds`` rounds, one per seed."""
+    return [results_from_rows(sim_evaluate(cfg, learner, opponent, rounds, s, td_model), ("ours", opponent))
+            .score_ratio("ours") for s in seeds]
+
+
+def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int,
+                 sim_seeds: int = SIM_SEEDS) -> None:
+    """Score tables of the run's greedy policy per opponent, in the simulator (seed ``seed``, and the range
+    over seeds ``seed .. seed + sim_seeds - 1``) and with ``engine="robocode"`` in the real engine."""
+    if sim_seeds < 1:
+        raise ValueError(f"sim_seeds must be >= 1, got {sim_seeds}")
     cfg = _run_config(run)
     learner, _ = load_model(run)
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
-    lines = ["| opponent | rounds | score ratio (simulator) | score ratio (robocode) | difference |",
-             "|---|---:|---:|---:|---:|"]
+    last = seed + sim_seeds - 1
+    lines = [f"| opponent | rounds | score ratio (simulator) | simulator, seeds {seed}-{last} (min-max) "
+             "| score ratio (robocode) | difference |", "|---|---:|---:|---:|---:|---:|"]
     for name in names:
         rows = sim_evaluate(cfg, learner, name, rounds, seed, summary.get("td_model"))
         sim = results_from_rows(rows, ("ours", name))
         sim_ratio = sim.score_ratio("ours")
+        spread = [sim_ratio] + sim_ratios(cfg, learner, name, rounds, range(seed + 1, last + 1),
+                                          summary.get("td_model"))
         click.echo(f"\n{name} in the simulator ({rounds} rounds):\n{sim.to_markdown()}")
         real = ""
         diff = ""
@@ -92,7 +110,7 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
             click.echo(f"{name} in Robocode ({rounds} rounds, {res.skipped_turns} skipped turns):\n"
                        f"{res.to_markdown()}")
             real, diff = f"{ratio:.3f}", f"{ratio - sim_ratio:+.3f}"
-        lines.append(f"| {name} | {rounds} | {sim_ratio:.3f} | {real} | {diff} |")
+        lines.append(f"| {name} | {rounds} | {sim_ratio:.3f} | {min(spread):.3f}-{max(spread):.3f} | {real} | {diff} |")
     click.echo("\n" + "\n".join(lines))
 
 

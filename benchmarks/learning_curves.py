@@ -7,7 +7,13 @@ Arms (each trained, or just played, for ``--rounds`` rounds per seed in the same
 - ``frozen``: the same DMNN at its initial weights, greedy, never learning,
 - ``td``: a fresh copy of the TD team's own tabular learner (epsilon-greedy Q-learning) on our side,
 - ``ssaq``: tabular SSAQ,
-- ``mirror``: the trained TD team itself on our side, greedy (a symmetry check: about 0.5).
+- ``mirror``: the trained TD team itself on our side, greedy (a symmetry check: about 0.5),
+- ``dodge``: a hand-written stochastic policy, no learning: forward or backward at random while the target is
+  to the side (relative-angle bins right/left), a random turn otherwise; ``dodge_det``: the same, deterministic
+  (always forward / always clockwise). They show what a policy over the paper's state can reach.
+
+With ``--reward score`` the learners are trained on the change of the team's score margin (ours - theirs,
+Robocode's score) per SMDP step instead of Eq. 35 (a diagnostic: the tables still show Eq. 35).
 
 Prints the mean score ratio per block of rounds (sessions of 10 pooled into ``--blocks`` blocks) with a 95%
 t-interval over seeds, and the first-vs-last block difference. Set ``CONFRONT_CACHE`` to a scratch folder.
@@ -26,7 +32,22 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 from scipy import stats  # noqa: E402
 
-ARMS = ("dmnn", "random", "frozen", "td", "ssaq", "mirror")
+ARMS = ("dmnn", "random", "frozen", "td", "ssaq", "mirror", "dodge", "dodge_det")
+
+
+def dodge_policy(stochastic: bool, n_actions: int):  # noqa: ANN201 - a Learner built on the uniform policy
+    """Hand-written reference: move perpendicular to the line to the target (paper's discrete state)."""
+    from confront.learning.uniform import UniformParams, UniformPolicy
+
+    class Dodge(UniformPolicy):
+        def act(self, obs: np.ndarray, rng: np.random.Generator, explore: bool = True) -> np.ndarray:
+            rel = np.asarray(obs) // 80  # state = (rel_bin * 4 + heading_bin) * 20 + dist_bin
+            side = (rel == 1) | (rel == 3)
+            if stochastic:
+                return np.where(side, rng.integers(0, 2, rel.shape), rng.integers(2, 4, rel.shape)).astype(np.int64)
+            return np.where(side, 0, 2).astype(np.int64)
+
+    return Dodge(UniformParams(n_actions=n_actions), kind="random")
 
 
 def parse_value(text: str) -> object:
@@ -42,9 +63,9 @@ def parse_value(text: str) -> object:
 
 
 def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
-            learner_params: tuple[tuple[str, object], ...] = ()) -> np.ndarray:
+            learner_params: tuple[tuple[str, object], ...] = (), reward: str = "eq35") -> np.ndarray:
     """(2, rounds // 10): per session of one arm at one seed, the score ratio and our tanks' mean Eq. 35 reward
-    per SMDP step; ``learner_params`` rebuild the DMNN."""
+    per SMDP step; ``learner_params`` rebuild the DMNN; ``reward="score"`` trains on the score instead (below)."""
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import _run, _setup, session_rows, td_learner
     from confront.learning.factory import clone_learner, make_learner
@@ -65,21 +86,32 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
         loop.learning = False
     elif arm == "td":
         loop.side.learner = td_learner(cfg, n_actions)
+    elif arm in ("dodge", "dodge_det"):
+        loop.side.learner = dodge_policy(arm == "dodge", n_actions)
     elif arm == "mirror":
         assert loop.side.opponent is not None
         opp = loop.side.opponent
         loop.side.learner = Frozen(clone_learner(opp.inner if isinstance(opp, Frozen) else opp))
         loop.learning = False
+    reward_kind = reward
     sessions = rounds // 10
     reward = np.zeros((2, sessions))  # per session of rounds: summed Eq. 35 reward of our tanks, tank-steps
     env_step = loop.env.step
+    team = loop.side.ours
+    last = np.zeros(loop.env.n_battles)  # (our team's score - theirs) so far in each battle's round
 
     def step(actions: np.ndarray):  # noqa: ANN202 - records our tanks' rewards per session, then steps
         res = env_step(actions)
-        ours = res.active & loop.side.ours[None, :]
+        ours = res.active & team[None, :]
         k = min(loop.rounds_done // 10, sessions - 1)
         reward[0, k] += res.rewards.sum(axis=2)[ours].sum()
         reward[1, k] += ours.sum()
+        margin = res.info["score"].sum(axis=2)
+        margin = margin[:, team].sum(axis=1) - margin[:, ~team].sum(axis=1)
+        if reward_kind == "score":  # every tank of ours gets the change of the team's score margin, spread over T
+            gain = (margin - last)[:, None, None] / res.rewards.shape[2]
+            res.rewards = np.broadcast_to(gain, res.rewards.shape).copy()
+        last[:] = np.where(res.round_done, 0.0, margin)
         return res
 
     loop.env.step = step  # type: ignore[method-assign]
@@ -105,6 +137,7 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=500)
     ap.add_argument("--blocks", type=int, default=5, help="blocks of rounds in the table")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--reward", choices=("eq35", "score"), default="eq35", help="what the learners are trained on")
     ap.add_argument("--set", dest="sets", action="append", default=[], help="config override for every arm")
     ap.add_argument("--learner", action="append", default=[],
                     help="KEY=VALUE: a DMNN parameter beyond the config (e.g. rate_units=network)")
@@ -118,12 +151,14 @@ def main() -> None:
     jobs = [(a, s) for a in arms for s in seeds]
     t0 = time.time()
     with ProcessPoolExecutor(args.workers) as pool:
-        futs = {job: pool.submit(run_arm, job[0], job[1], args.rounds, tuple(args.sets), extra) for job in jobs}
+        futs = {job: pool.submit(run_arm, job[0], job[1], args.rounds, tuple(args.sets), extra,
+                                  args.reward) for job in jobs}
         curves = {job: f.result() for job, f in futs.items()}
     n_sess = args.rounds // 10
     edges = np.linspace(0, n_sess, args.blocks + 1).astype(int)
     heads = [f"rounds {10 * lo + 1}-{10 * hi}" for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
     print(f"\n{len(list(seeds))} seeds x {args.rounds} rounds, overrides {args.sets + args.learner or 'none'}, "
+          f"trained on {args.reward}, "
           f"{time.time() - t0:.0f} s; mean [95% t-interval over seeds]")
     for row, what in ((0, "score ratio"), (1, "mean Eq. 35 reward per tank and SMDP step")):
         print(f"\n{what}\n")

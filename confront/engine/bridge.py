@@ -3,25 +3,26 @@
 Protocol v2, one line per message (UTF-8). Robot -> Python:
 - once per round and connection, JSON ``{"v": 2, "type": "hello", "token", "name", "team" (team-mates'
   names joined by ";"), "round", "rounds", "width", "height"}``;
-- in turns 1, 1 + EVERY, 1 + 2 EVERY, ... ``O ROUND TURN X Y HEADING GUN_HEADING RADAR_HEADING VELOCITY
-  ENERGY GUN_HEAT OTHERS DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS<TAB>HISTORY``: SCANS is the latest sighting of each
-  robot, joined by "|", each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``;
-  EVENTS a JSON list of the events since the last observation; HISTORY (empty unless asked for) one
+- for the decision turns 1, 1 + EVERY, 1 + 2 EVERY, ... (sent LEAD turns before them, the first in turn 1)
+  ``O ROUND TURN X Y HEADING GUN_HEADING RADAR_HEADING VELOCITY ENERGY GUN_HEAT OTHERS
+  DISTANCE_REMAINING<TAB>SCANS<TAB>EVENTS<TAB>HISTORY``: SCANS is the latest sighting of each robot, joined
+  by "|", each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``; EVENTS a JSON list
+  of the events since the last observation; HISTORY (empty unless asked for) one
   ``TIME;ENERGY;TARGET;TARGET_PREVIOUS;TARGET_ENERGY`` record per turn since the last observation, joined by
   "|" (:class:`TurnEnergy`); TURN is the engine turn the answer takes effect in;
 - ``E ROUND TIME HOW ENERGY DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US<TAB>HISTORY`` at death or
-  round end: the round's decisions, their summed round trips (robot sends .. reads the answer) and how many
-  took over 1 ms, the turns played and the robot's own time outside ``execute()`` (deciding and the
-  controller), and the history records since the last observation.
-Python -> robot: ``OK 2 EVERY HISTORY(0/1) N`` after a valid hello, followed by N ``key value`` lines: the parameters of
-the fixed gun/radar controller (:class:`~confront.arena.control.ControlConfig`) that the robot then runs in
-Java every turn (N = 0: no controller, the answers' gun, radar and fire are used);
-``A TURN AHEAD TURN GUN RADAR FIRE`` per observation (radians, + clockwise; ``NaN`` keeps the remaining
-value; fire 0 = no shot). Between decisions the robot's commands keep running (remaining distance and
-turns) with no round trip. A compact text line instead of JSON keeps the cost low (measured:
-docs/engine.md). A robot whose Python side fails (no answer within its timeout, closed socket, bad line)
-plays a built-in behaviour for the rest of the round and reports ``bridge-failed``; the runner collects
-those reports.
+  round end: the round's decisions, the time the robot was held up by their round trips and how many took
+  over 1 ms, the turns played and the robot's own time outside ``execute()`` (deciding and the controller),
+  and the history records since the last observation.
+Python -> robot: ``OK 2 EVERY LEAD HISTORY(0/1) N`` after a valid hello (:class:`BridgeSettings`), followed
+by N ``key value`` lines: the parameters of the fixed gun/radar controller
+(:class:`~confront.arena.control.ControlConfig`) that the robot then runs in Java every turn (N = 0: no
+controller, the answers' gun, radar and fire are used); ``A TURN AHEAD TURN GUN RADAR FIRE`` per
+observation (radians, + clockwise; ``NaN`` keeps the remaining value; fire 0 = no shot). Between decisions
+the robot's commands keep running (remaining distance and turns) with no round trip. A compact text line
+instead of JSON keeps the cost low (measured: docs/engine.md). A robot whose Python side fails (no answer
+within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the round and
+reports ``bridge-failed``; the runner collects those reports.
 """
 
 from __future__ import annotations
@@ -117,21 +118,27 @@ class BridgeSettings:
     the policy's gun, radar and fire answers are used (and hold between decisions). ``history``: the robots
     record every turn's energies (:class:`TurnEnergy`) and send them with the next observation
     (``Observation.history``) and at death or round end, where the policy's ``end_episode(robot, round,
-    history)`` gets them (so per-turn rewards need no per-turn round trip).
+    history)`` gets them (so per-turn rewards need no per-turn round trip). ``lead``: send the observation
+    this many turns before its decision turn and read the answer in that turn, so the policy runs while the
+    engine plays on (the decision then rests on a state ``lead`` turns old; the first of a round is taken in
+    turn 1 as usual); 0 = ask and wait in the decision turn (what the exported robot and the simulator do).
     """
 
     every: int = 1
     controller: ControlConfig | None = None
     history: bool = False
+    lead: int = 0
 
     def __post_init__(self) -> None:
         if self.every < 1:
             raise ValueError(f"every must be >= 1, got {self.every}")
+        if not 0 <= self.lead < self.every:
+            raise ValueError(f"lead must be in [0, every) = [0, {self.every}), got {self.lead}")
 
     def hello_reply(self) -> str:
-        """``OK 2 EVERY HISTORY N`` and the controller's N ``key value`` lines (the policy file's, export.py)."""
+        """``OK 2 EVERY LEAD HISTORY N`` and the controller's N ``key value`` lines (the policy file's)."""
         lines = controller_lines(self.controller) if self.controller is not None else []
-        first = f"OK {PROTOCOL_VERSION} {self.every} {int(self.history)} {len(lines)}"
+        first = f"OK {PROTOCOL_VERSION} {self.every} {self.lead} {int(self.history)} {len(lines)}"
         return "".join(line + "\n" for line in [first, *lines])
 
 

@@ -39,7 +39,8 @@ def bridge_options(options: EngineOptions, port: int, token: str, timeout_ms: in
 class BridgedRun:
     """An engine run plus what the bridge saw: decisions served, errors, robots that fell back, and times.
 
-    Per decision, means in microseconds: ``rtt_mean_us`` the round trip as the robots timed it,
+    Per decision, means in microseconds: ``rtt_mean_us`` the time a robot was held up by the round trip
+    (sending, and waiting for the answer; with ``lead`` = 0 the whole round trip) as the robots timed it,
     ``policy_us`` inside the policy, ``handling_us`` the server's own work (parse, format, send); per robot
     turn ``work_us_per_turn`` the robots' own time outside execute() (deciding, round trips included, and the
     controller). Statistics of a round that a robot played in fallback are lost with its connection.
@@ -77,6 +78,7 @@ def run_bridged_battle(
     extra_robots: Sequence[str | os.PathLike[str]] = (),
     controller: ControlConfig | None = None,
     history: bool = False,
+    lead: int = 0,
 ) -> BridgedRun:
     """Run ``spec`` (whose contestants include BridgeBot tanks) with ``policy`` deciding for every BridgeBot.
 
@@ -84,12 +86,13 @@ def run_bridged_battle(
     SMDP step T); the commands keep running in between. ``controller``: the robots run this fixed gun/radar
     controller themselves every turn (the answers' gun, radar and fire are then ignored), so a policy that
     only picks moves costs one round trip per ``every`` turns. ``history``: the robots send every turn's energies
-with the next observation and at the round's end (``BridgeSettings``). ``extra_robots``: robot jars or folders to add
+with the next observation and at the round's end; ``lead``: ask that many turns ahead (``BridgeSettings``).
+    ``extra_robots``: robot jars or folders to add
     (e.g. exported PolicyBot opponents).
     """
     opts = options or EngineOptions(cpu_constant_ms=BRIDGE_CPU_CONSTANT_MS)
     tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)
-    with BridgeServer(policy, settings=BridgeSettings(every, controller, history)) as server:
+    with BridgeServer(policy, settings=BridgeSettings(every, controller, history, lead)) as server:
         run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo), workdir=workdir,
                          extra_robots=extra_robots)
     st = server.stats

@@ -123,15 +123,21 @@ def test_java_controller_between_decisions_plays_like_the_exported_robot(install
             (c.name.startswith("sample."), c.total) for c in java.results.contestants]
 
 
-def test_history_brings_every_turn_between_decisions(install) -> None:
-    """history=True: each turn's energies arrive once, with the next observation or at the round's end."""
+@pytest.mark.parametrize("lead", [0, 3])
+def test_history_brings_every_turn_between_decisions(install, lead: int) -> None:
+    """history=True: each turn's energies arrive once, with the next observation or at the round's end;
+    with a lead the observation leaves ``lead`` turns before its decision turn (the first in turn 1)."""
     policy = ExportedPolicy("qtable", q=np.random.default_rng(5).normal(size=(320, 4)), step_turns=5)
     records: dict[int, list[TurnEnergy]] = {}
     ends: list[tuple[int, int]] = []
+    sent: list[bool] = []
 
     class Recording:
         def __call__(self, obs: Observation):
-            assert obs.history[-1].time == obs.turn - 1 and obs.history[-1].energy == obs.energy
+            ahead = lead if obs.turn > 1 else 0
+            sent.append(obs.history[-1].time == obs.turn - 1 - ahead)  # false only after a skipped turn
+            assert obs.turn - 1 - ahead <= obs.history[-1].time <= obs.turn - 1
+            assert obs.history[-1].energy == obs.energy
             records.setdefault(obs.round, []).extend(obs.history)
             return policy(obs)
 
@@ -141,9 +147,10 @@ def test_history_brings_every_turn_between_decisions(install) -> None:
 
     opts = EngineOptions(seed=3, cpu_constant_ms=50)
     res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SpinBot"), rounds=2), Recording(), opts, every=5,
-                             controller=policy.control, history=True)
+                             controller=policy.control, history=True, lead=lead)
     assert res.ok, (res.failures, res.server_errors)
     assert [r for r, _ in ends] == [0, 1] and all(n >= 1 for _, n in ends)
+    assert res.run.skipped_turns or all(sent)
     for hs in records.values():
         times = [h.time for h in hs]
         assert times[0] == 0 and all(b > a for a, b in zip(times, times[1:], strict=False))

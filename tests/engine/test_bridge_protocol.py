@@ -80,16 +80,18 @@ def test_bad_hello_rejected() -> None:
 
 
 def test_hello_reply_carries_interval_and_controller() -> None:
-    assert BridgeSettings().hello_reply() == "OK 2 1 0 0\n"
-    assert BridgeSettings(4, history=True).hello_reply() == "OK 2 4 1 0\n"
+    assert BridgeSettings().hello_reply() == "OK 2 1 0 0 0\n"
+    assert BridgeSettings(4, history=True, lead=3).hello_reply() == "OK 2 4 3 1 0\n"
     ctl = ControlConfig(power_near=2.5, fire=False)
     lines = BridgeSettings(10, ctl).hello_reply().splitlines()
     n = len(fields(ControlConfig))
-    assert lines[0] == f"OK 2 10 0 {n}" and len(lines) == n + 1
+    assert lines[0] == f"OK 2 10 0 0 {n}" and len(lines) == n + 1
     assert "power_near 2.5" in lines and "fire 0" in lines and "near_distance 150.0" in lines
     assert f"turn_angle {math.radians(45.0)!r}" in lines
     with pytest.raises(ValueError, match="every"):
         BridgeSettings(0)
+    with pytest.raises(ValueError, match="lead"):
+        BridgeSettings(4, lead=4)
 
 
 def test_format_action() -> None:
@@ -135,7 +137,7 @@ def test_server_round_trip_on_loopback() -> None:
         assert server.port > 0
         with socket.create_connection(("127.0.0.1", server.port), timeout=5) as s:
             s.sendall((json.dumps(HELLO) + "\n").encode())
-            assert _lines(s, 1) == ["OK 2 5 0 0"]
+            assert _lines(s, 1) == ["OK 2 5 0 0 0"]
             s.sendall((obs_line() + "\n" + obs_line(turn=8, scans="", events="[]") + "\n").encode())
             assert _lines(s, 2) == ["A 7 7.0 NaN 0.0 0.0 1.5", "A 8 8.0 NaN 0.0 0.0 1.5"]
             s.sendall(b"E 0 9 death 0.0 2 300 1 9 450\t9;0.0;sample.Walls;50.0;50.0\n")

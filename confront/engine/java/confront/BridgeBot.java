@@ -31,9 +31,11 @@ import robocode.util.Utils;
  * Settings come from JVM system properties (the engine runs with -DNOSECURITY=true so that robots may use
  * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs. Protocol version 2
  * (format in confront/engine/bridge.py), one line per message: the robot sends a JSON "hello" once per round
- * and Python answers "OK 2 EVERY HISTORY N" plus N "key value" lines of the fixed gun/radar controller (N = 0:
- * none); with HISTORY = 1 the robot records every turn's energies and sends them with the next message.
- * The robot then sends an "O ..." observation in turns 1, 1 + EVERY, 1 + 2 EVERY, ... and "E ..." at death
+ * and Python answers "OK 2 EVERY LEAD HISTORY N" plus N "key value" lines of the fixed gun/radar controller
+ * (N = 0: none); with HISTORY = 1 the robot records every turn's energies and sends them with the next message.
+ * The robot then asks for decisions in turns 1, 1 + EVERY, 1 + 2 EVERY, ...: it sends the "O ..." observation
+ * LEAD turns before such a turn (0: in it; the first of a round always in turn 1) and reads the answer in it,
+ * so with LEAD > 0 Python decides while the engine plays on (from a state LEAD turns old); "E ..." at death
  * or round end; Python answers each observation with "A TURN AHEAD TURN GUN RADAR FIRE" (radians,
  * + clockwise; "NaN" keeps the current remaining value; fire 0 = no shot). Between decisions the commands keep
  * running and, with a controller, PolicyModel's gun/radar controller aims and fires every turn (its commands
@@ -50,6 +52,10 @@ public class BridgeBot extends TeamRobot {
     private boolean failed;
     private boolean finished;
     private int every = 1;
+    private int lead;
+    private long nextDecision = 1;
+    private boolean pending;
+    private long requestNanos;
     private boolean keepHistory;
     private PolicyModel controller;
     // per turn since the last message: TIME;OWN_ENERGY;TARGET;TARGET_PREVIOUS_ENERGY;TARGET_ENERGY, joined by "|"
@@ -82,9 +88,22 @@ public class BridgeBot extends TeamRobot {
             if (keepHistory && !failed && !finished) {
                 record();
             }
-            if (!failed && !finished && (turn - 1) % every == 0) {
+            if (!failed && !finished) {
                 try {
-                    decide(turn);
+                    if (!pending) {
+                        while (nextDecision < turn) {
+                            nextDecision += every;  // a skipped turn passed a decision turn: take the next one
+                        }
+                        if (turn >= nextDecision - lead) {
+                            request(nextDecision);  // "lead" turns ahead: Python works while the engine runs
+                            pending = true;
+                        }
+                    }
+                    if (pending && turn >= nextDecision) {
+                        receive(nextDecision);  // late only when a skipped turn passed the decision turn
+                        pending = false;
+                        nextDecision += every;
+                    }
                 } catch (IOException | RuntimeException e) {
                     fail(e.getClass().getSimpleName() + ": " + e.getMessage());
                 }
@@ -120,14 +139,15 @@ public class BridgeBot extends TeamRobot {
                     + ",\"width\":" + getBattleFieldWidth() + ",\"height\":" + getBattleFieldHeight() + "}");
             String reply = in.readLine();
             String[] p = reply == null ? new String[0] : reply.split(" ");
-            if (p.length != 5 || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
+            if (p.length != 6 || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
                 fail("bad hello reply " + reply);
                 return;
             }
             every = Integer.parseInt(p[2]);
-            keepHistory = p[3].equals("1");
-            int n = Integer.parseInt(p[4]);
-            if (every < 1 || !(p[3].equals("0") || keepHistory) || n < 0 || n > 100) {
+            lead = Integer.parseInt(p[3]);
+            keepHistory = p[4].equals("1");
+            int n = Integer.parseInt(p[5]);
+            if (every < 1 || lead < 0 || lead >= every || !(p[4].equals("0") || keepHistory) || n < 0 || n > 100) {
                 fail("bad hello reply " + reply);
                 return;
             }
@@ -159,7 +179,8 @@ public class BridgeBot extends TeamRobot {
         return mates == null ? "" : String.join(";", mates);
     }
 
-    private void decide(long turn) throws IOException {
+    /** Send the observation for decision turn ``turn`` (now, or ``lead`` turns before it). */
+    private void request(long turn) throws IOException {
         StringBuilder b = new StringBuilder(256);
         b.append("O ").append(getRoundNum()).append(' ').append(turn)
                 .append(' ').append(getX()).append(' ').append(getY())
@@ -185,8 +206,14 @@ public class BridgeBot extends TeamRobot {
         long t0 = System.nanoTime();
         out2.write(b.toString().getBytes(StandardCharsets.UTF_8));
         out2.flush();
+        requestNanos = System.nanoTime() - t0;
+    }
+
+    /** Read and apply the answer for ``turn``; times how long this robot was held up (sending and waiting). */
+    private void receive(long turn) throws IOException {
+        long t0 = System.nanoTime();
         String line = in.readLine();
-        long dt = System.nanoTime() - t0;
+        long dt = System.nanoTime() - t0 + requestNanos;
         rttN++;
         rttSum += dt;
         if (dt > 1000000) {

@@ -8,13 +8,16 @@ constant everywhere) four modes, interleaved and repeated (the order rotates eac
 - ``bridge T``: BridgeBots asking the Python twin of that policy in turns 1, 1 + T, ... with the controller
   running in Java in between (``run_bridged_battle(every=T, controller=...)``): the same battle as ``java``
   turn by turn when no turn is skipped (the benchmark checks the turn counts);
+- ``bridge T lead``: the same, but each observation leaves ``--lead`` turns before its decision turn, so the
+  policy runs while the engine plays on (decisions rest on a state that many turns old: a different battle);
 - ``bridge 1``: the Python twin decides every turn, gun and radar included (no controller in Java).
 T is the configs' ``arena.decision_turns`` (10). Bridge cost = 1 - bridged turns/s / reference turns/s,
 per repetition (neighbouring runs, similar machine load), excluding the round-start wait; the wait is
 reported on its own. "excl. policy" also leaves out the time spent inside the Python policy itself (what a
 Java policy would cost instead is in the ``java`` row). Goal of issue 5: cost <= 25%.
 
-Usage: python benchmarks/bridge_throughput.py [--rounds 10] [--repeats 3] [--cpu-ms 30] [--check-rounds 100]
+Usage: python benchmarks/bridge_throughput.py [--rounds 10] [--repeats 3] [--cpu-ms 30] [--lead 5]
+       [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--json FILE]
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from confront.experiments.spec import ArenaSection
 
 OPPONENTS = ("Walls", "Tracker", "SpinBot", "RamFire")
 STAND_IN = "Tracker"  # the sample robot that takes our place in the sample-only battle
-MODES = ("sample", "java", "bridge T", "bridge 1")
+MODES = ("sample", "java", "bridge T", "bridge T lead", "bridge 1")
 
 
 def _spec(size: int, ours: str, rounds: int) -> BattleSpec:
@@ -65,15 +68,15 @@ def _record(battle: str, mode: str, rep: int, run: EngineRun, wall: float, br: B
 
 
 def _runner(mode: str, size: int, rounds: int, opts: EngineOptions, policy: ExportedPolicy, exported: Path,
-            every: int) -> Callable[[], tuple[EngineRun, BridgedRun | None]]:
+            every: int, lead: int) -> Callable[[], tuple[EngineRun, BridgedRun | None]]:
     def run() -> tuple[EngineRun, BridgedRun | None]:
         if mode == "sample":
             return run_battle(_spec(size, STAND_IN, rounds), opts), None
         if mode == "java":
             return run_battle(_spec(size, "confront.PolicyBot*", rounds), opts, extra_robots=[exported]), None
-        if mode == "bridge T":
+        if mode in ("bridge T", "bridge T lead"):
             br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), policy, opts, every=every,
-                                    controller=policy.control)
+                                    controller=policy.control, lead=lead if mode == "bridge T lead" else 0)
         else:
             br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), policy, opts, every=1)
         return br.run, br
@@ -96,7 +99,7 @@ def _mean(records: list[dict[str, Any]], key: str) -> str:
 def report(records: list[dict[str, Any]]) -> None:
     """Print per battle and mode the medians (ranges) over the repetitions, then the costs."""
     print("battle | mode | turns | turns/s excl. set-up | turns/s | set-up s | skipped | decisions | "
-          "round trip us | over 1 ms | policy us | server us | robot work us/turn")
+          "held up by round trip us | over 1 ms | policy us | server us | robot work us/turn")
     for battle in dict.fromkeys(r["battle"] for r in records):
         for mode in MODES:
             rs = [r for r in records if r["battle"] == battle and r["mode"] == mode]
@@ -109,7 +112,7 @@ def report(records: list[dict[str, Any]]) -> None:
                   f"{_mean(rs, 'policy_us')} | {_mean(rs, 'handling_us')} | {_mean(rs, 'work_us_per_turn')}")
     print("\nbridge cost = 1 - bridged/reference turns/s excl. set-up, per repetition: median (range); goal <= 25%")
     for battle in dict.fromkeys(r["battle"] for r in records):
-        for mode in ("bridge T", "bridge 1"):
+        for mode in ("bridge T", "bridge T lead", "bridge 1"):
             for ref in ("sample", "java"):
                 for key, label in (("turns_per_s_excl_setup", ""), ("turns_per_s_excl_policy", ", excl. policy")):
                     costs = []
@@ -149,6 +152,7 @@ def main() -> None:
     ap.add_argument("--cpu-ms", type=float, default=BRIDGE_CPU_CONSTANT_MS, help="engine CPU constant (ms)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--every", type=int, default=ArenaSection().decision_turns, help="T: turns per decision")
+    ap.add_argument("--lead", type=int, default=5, help="turns ahead for the 'bridge T lead' mode")
     ap.add_argument("--battles", default="1v1,4v4")
     ap.add_argument("--modes", default=",".join(MODES))
     ap.add_argument("--check-rounds", type=int, default=0, help="also a bridged 1v1 of this many rounds")
@@ -163,7 +167,7 @@ def main() -> None:
     policy = ExportedPolicy("qtable", q=np.random.default_rng(args.seed).normal(size=(320, 4)),
                             step_turns=args.every)
     print(f"rounds={args.rounds} repeats={args.repeats} cpu_constant_ms={args.cpu_ms} seed={args.seed} "
-          f"T={args.every} load average at start {os.getloadavg()[0]:.1f}", flush=True)
+          f"T={args.every} lead={args.lead} load average at start {os.getloadavg()[0]:.1f}", flush=True)
     records = []
     with tempfile.TemporaryDirectory(prefix="confront-bench-") as tmp:
         exported = export_robot(policy, Path(tmp) / "robots")
@@ -172,7 +176,8 @@ def main() -> None:
             for battle in battles:
                 for mode in order:
                     t0 = time.perf_counter()
-                    run, br = _runner(mode, sizes[battle], args.rounds, opts, policy, exported, args.every)()
+                    run, br = _runner(mode, sizes[battle], args.rounds, opts, policy, exported, args.every,
+                                      args.lead)()
                     rec = _record(battle, mode, rep, run, time.perf_counter() - t0, br)
                     records.append(rec)
                     print(f"  [{rep}] {battle} {mode}: {rec['turns']} turns, {rec['turns_per_s_excl_setup']:.0f} "

@@ -18,6 +18,8 @@ from confront.experiments.train import Loop, Side, _run, load_model, scenario_of
 from confront.learning.base import Learner
 from confront.results import BattleResults, ScoreRow
 
+SIM_SEEDS = 5  # simulator seeds per opponent: the simulator is cheap, and their spread shows a ratio's noise
+SIM_BATTLES = 16  # battles side by side in a simulator evaluation
 PARTS = ("survival", "last_survivor", "bullet_damage", "bullet_kill_bonus", "ram_damage", "ram_kill_bonus")
 
 
@@ -41,7 +43,7 @@ def results_from_rows(rows: list[dict[str, Any]], names: tuple[str, str]) -> Bat
 
 
 def sim_evaluate(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seed: int,
-                 td_model: str | None = None, battles: int = 16) -> list[dict[str, Any]]:
+                 td_model: str | None = None, battles: int = SIM_BATTLES) -> list[dict[str, Any]]:
     """Play ``learner`` greedily (no exploration, no learning) against ``opponent`` in the simulator."""
     env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=min(battles, rounds), seed=seed,
                         opponents=opponent, config=smdp_config(cfg))
@@ -67,10 +69,14 @@ def exported_policy(learner: Learner, cfg: ExperimentConfig) -> Any:
                                        step_turns=cfg.arena.decision_turns)
 
 
-SIM_SEEDS = 5  # simulator seeds per opponent: the simulator is cheap, and their spread shows a ratio's noise
+def disjoint_seeds(seed: int, n: int, rounds: int, battles: int = SIM_BATTLES) -> list[int]:
+    """``n`` evaluation seeds from ``seed`` whose battles share no seed: battle b of a run with seed s is
+    seeded s + b (``Arena.seed``), so consecutive seeds would replay all but one battle."""
+    step = min(battles, rounds)
+    return [seed + k * step for k in range(n)]
 
 
-def sim_ratios(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seeds: range,
+def sim_ratios(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seeds: list[int],
                td_model: str | None = None) -> list[float]:
     """Our score ratio in the simulator against ``opponent`` over ``rounds`` rounds, one per seed."""
     return [results_from_rows(sim_evaluate(cfg, learner, opponent, rounds, s, td_model), ("ours", opponent))
@@ -80,22 +86,22 @@ def sim_ratios(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: i
 def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int,
                  sim_seeds: int = SIM_SEEDS) -> None:
     """Score tables of the run's greedy policy per opponent, in the simulator (seed ``seed``, and the range
-    over seeds ``seed .. seed + sim_seeds - 1``) and with ``engine="robocode"`` in the real engine."""
+    over ``sim_seeds`` runs with disjoint battle seeds from ``seed`` on) and with ``engine="robocode"`` in the
+    real engine."""
     if sim_seeds < 1:
         raise ValueError(f"sim_seeds must be >= 1, got {sim_seeds}")
     cfg = _run_config(run)
     learner, _ = load_model(run)
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
-    last = seed + sim_seeds - 1
-    lines = [f"| opponent | rounds | score ratio (simulator) | simulator, seeds {seed}-{last} (min-max) "
+    seeds = disjoint_seeds(seed, sim_seeds, rounds)
+    lines = [f"| opponent | rounds | score ratio (simulator) | simulator, {sim_seeds} seeds (min-max) "
              "| score ratio (robocode) | difference |", "|---|---:|---:|---:|---:|---:|"]
     for name in names:
         rows = sim_evaluate(cfg, learner, name, rounds, seed, summary.get("td_model"))
         sim = results_from_rows(rows, ("ours", name))
         sim_ratio = sim.score_ratio("ours")
-        spread = [sim_ratio] + sim_ratios(cfg, learner, name, rounds, range(seed + 1, last + 1),
-                                          summary.get("td_model"))
+        spread = [sim_ratio] + sim_ratios(cfg, learner, name, rounds, seeds[1:], summary.get("td_model"))
         click.echo(f"\n{name} in the simulator ({rounds} rounds):\n{sim.to_markdown()}")
         real = ""
         diff = ""
@@ -111,7 +117,7 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
                        f"{res.to_markdown()}")
             real, diff = f"{ratio:.3f}", f"{ratio - sim_ratio:+.3f}"
         lines.append(f"| {name} | {rounds} | {sim_ratio:.3f} | {min(spread):.3f}-{max(spread):.3f} | {real} | {diff} |")
-    click.echo("\n" + "\n".join(lines))
+    click.echo("\n" + "\n".join(lines) + f"\n(simulator seeds {', '.join(map(str, seeds))}: no battle in common)")
 
 
 def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int) -> BattleResults:

@@ -6,7 +6,14 @@ from pathlib import Path
 
 import pytest
 
-from confront.experiments.evaluate import _run_config, evaluate_cli, results_from_rows, sim_evaluate, sim_ratios
+from confront.experiments.evaluate import (
+    _run_config,
+    disjoint_seeds,
+    evaluate_cli,
+    results_from_rows,
+    sim_evaluate,
+    sim_ratios,
+)
 from confront.experiments.spec import load_experiment
 from confront.experiments.train import load_model, train_run
 
@@ -28,9 +35,12 @@ def test_evaluate_table_has_the_simulator_ratio_and_its_seed_range(tmp_path: Pat
         rows = sim_evaluate(cfg, learner, name, 6, 3)
         ratio = results_from_rows(rows, ("ours", name)).score_ratio("ours")
         assert cells[1] == "6" and cells[2] == f"{ratio:.3f}"
-        spread = sim_ratios(cfg, learner, name, 6, range(3, 6))
+        spread = sim_ratios(cfg, learner, name, 6, [3, 9, 15])
         assert spread[0] == ratio  # the same seed repeats exactly
         assert cells[3] == f"{min(spread):.3f}-{max(spread):.3f}"
         assert cells[4] == "" and cells[5] == ""  # no engine column without --engine robocode
+    # battle b of seed s is seeded s + b: 6 rounds run in 6 battles, so the runs start 6 seeds apart
+    assert disjoint_seeds(3, 3, rounds=6) == [3, 9, 15]
+    assert disjoint_seeds(1, 4, rounds=100) == [1, 17, 33, 49]
     with pytest.raises(ValueError, match="sim_seeds"):
         evaluate_cli(run, "sim", "SpinBot", rounds=2, seed=0, sim_seeds=0)

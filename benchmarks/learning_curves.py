@@ -12,8 +12,10 @@ Arms (each trained, or just played, for ``--rounds`` rounds per seed in the same
   to the side (relative-angle bins right/left), a random turn otherwise; ``dodge_det``: the same, deterministic
   (always forward / always clockwise). They show what a policy over the paper's state can reach.
 
-With ``--reward score`` the learners are trained on the change of the team's score margin (ours - theirs,
-Robocode's score) per SMDP step instead of Eq. 35 (a diagnostic: the tables still show Eq. 35).
+Diagnostics: with ``--reward score`` the learners are trained on the change of the team's score margin (ours -
+theirs, Robocode's score) per SMDP step instead of Eq. 35; with ``--reward approach`` on the distance each tank
+closed to its target (px / 100), a signal the state determines (the last table then shows the mean distance to
+the target, px, to see whether the learners learn to close in).
 
 Prints the mean score ratio per block of rounds (sessions of 10 pooled into ``--blocks`` blocks) with a 95%
 t-interval over seeds, and the first-vs-last block difference. Set ``CONFRONT_CACHE`` to a scratch folder.
@@ -64,8 +66,9 @@ def parse_value(text: str) -> object:
 
 def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
             learner_params: tuple[tuple[str, object], ...] = (), reward: str = "eq35") -> np.ndarray:
-    """(2, rounds // 10): per session of one arm at one seed, the score ratio and our tanks' mean Eq. 35 reward
-    per SMDP step; ``learner_params`` rebuild the DMNN; ``reward="score"`` trains on the score instead (below)."""
+    """(3, rounds // 10): per session of one arm at one seed, the score ratio, our tanks' mean Eq. 35 reward per
+    SMDP step and their mean distance to the target (px); ``learner_params`` rebuild the DMNN; ``reward`` is what
+    the learners are trained on (module docstring)."""
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import _run, _setup, session_rows, td_learner
     from confront.learning.factory import clone_learner, make_learner
@@ -95,7 +98,8 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
         loop.learning = False
     reward_kind = reward
     sessions = rounds // 10
-    reward = np.zeros((2, sessions))  # per session of rounds: summed Eq. 35 reward of our tanks, tank-steps
+    reward = np.zeros((3, sessions))  # per session of rounds: summed Eq. 35 reward, tank-steps, summed distance
+    diag = loop.env.max_distance
     env_step = loop.env.step
     team = loop.side.ours
     last = np.zeros(loop.env.n_battles)  # (our team's score - theirs) so far in each battle's round
@@ -106,6 +110,13 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
         k = min(loop.rounds_done // 10, sessions - 1)
         reward[0, k] += res.rewards.sum(axis=2)[ours].sum()
         reward[1, k] += ours.sum()
+        before = loop.feats[..., 4] * diag  # feature 4: distance to the target / max_distance (before the step)
+        after = (np.where(res.round_done[:, None], res.final_features[..., 4], res.features[..., 4])
+                 if res.final_features is not None else res.features[..., 4]) * diag
+        reward[2, k] += before[ours].sum()
+        if reward_kind == "approach":
+            res.rewards = np.repeat(((before - after) / 100.0 / res.rewards.shape[2])[..., None],
+                                    res.rewards.shape[2], axis=2)
         margin = res.info["score"].sum(axis=2)
         margin = margin[:, team].sum(axis=1) - margin[:, ~team].sum(axis=1)
         if reward_kind == "score":  # every tank of ours gets the change of the team's score margin, spread over T
@@ -117,7 +128,7 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
     loop.env.step = step  # type: ignore[method-assign]
     _run(loop, rounds, progress=False, desc=arm)
     ratio = np.array([s["score_ratio"] for s in session_rows(loop.rows[:rounds], 10)])
-    return np.stack([ratio, reward[0] / np.maximum(reward[1], 1)])
+    return np.stack([ratio, reward[0] / np.maximum(reward[1], 1), reward[2] / np.maximum(reward[1], 1)])
 
 
 def interval(values: np.ndarray) -> tuple[float, float, float]:
@@ -137,7 +148,8 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=500)
     ap.add_argument("--blocks", type=int, default=5, help="blocks of rounds in the table")
     ap.add_argument("--workers", type=int, default=1)
-    ap.add_argument("--reward", choices=("eq35", "score"), default="eq35", help="what the learners are trained on")
+    ap.add_argument("--reward", choices=("eq35", "score", "approach"), default="eq35",
+                    help="what the learners are trained on")
     ap.add_argument("--set", dest="sets", action="append", default=[], help="config override for every arm")
     ap.add_argument("--learner", action="append", default=[],
                     help="KEY=VALUE: a DMNN parameter beyond the config (e.g. rate_units=network)")
@@ -160,7 +172,8 @@ def main() -> None:
     print(f"\n{len(list(seeds))} seeds x {args.rounds} rounds, overrides {args.sets + args.learner or 'none'}, "
           f"trained on {args.reward}, "
           f"{time.time() - t0:.0f} s; mean [95% t-interval over seeds]")
-    for row, what in ((0, "score ratio"), (1, "mean Eq. 35 reward per tank and SMDP step")):
+    for row, what in ((0, "score ratio"), (1, "mean Eq. 35 reward per tank and SMDP step"),
+                      (2, "mean distance to the target, px")):
         print(f"\n{what}\n")
         table(arms, seeds, curves, row, edges, heads)
 

@@ -47,6 +47,7 @@ __all__ = [
 OUTPUTS = ("linear", "bipolar")
 OBSERVATIONS = ("features", "discrete")
 DTYPES = ("float64", "float32")
+OUTPUT_INITS = ("zero", "uniform")
 UNITS = ("q", "network")  # Q in reward units, or the network's own output units y = Q / q_scale
 
 
@@ -132,6 +133,7 @@ class DMNNParams(LearnerParams):
     q_scale: float = 10.0
     td_clip: float = 5.0
     rate_units: str = "network"
+    output_init: str = "zero"
     softmax_units: str = "q"
     gamma: float = 0.9
     alpha: float = 0.1
@@ -166,6 +168,7 @@ class DMNNParams(LearnerParams):
         check_range("td_clip", self.td_clip, 0.0, 1e12)
         check_choice("rate_units", self.rate_units, UNITS)
         check_choice("softmax_units", self.softmax_units, UNITS)
+        check_choice("output_init", self.output_init, OUTPUT_INITS)
         check_range("gamma", self.gamma, 0.0, 1.0)
         check_range("alpha", self.alpha, 0.0, 1.0, lo_open=True)
         check_choice("rate", self.rate, RATES)
@@ -200,6 +203,8 @@ class DMNN(Learner):
         self.dtype = np.dtype(p.dtype)
         sizes = (p.n_inputs, *p.hidden, p.n_actions)
         self.weights = [(rng.uniform(-1.0, 1.0, (i, o)) / np.sqrt(i)).astype(self.dtype) for i, o in pairwise(sizes)]
+        if p.output_init == "zero":  # Q(s, .) = 0 at the start, as the tables' q_init (whatever q_scale is)
+            self.weights[-1][:] = 0.0
         self.biases = [np.zeros(o, dtype=self.dtype) for o in sizes[1:]]
         self.vel_w = [np.zeros_like(w) for w in self.weights]
         self.vel_b = [np.zeros_like(th) for th in self.biases]

@@ -448,7 +448,7 @@ def _move(rf, rb, b, i):
         rf[b, BY, i] = rf[b, Y, i]
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple[bool, float, float, float]:
     """RobotPeer.checkWallCollision geometry: (hit, new x, new y, bearing of the wall)."""
     min_x = ROBOT_HALF
@@ -597,8 +597,10 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
             ext -= TWO_PI
         ux = math.sin(start)
         uy = math.cos(start)
-        vx = math.sin(start + ext)
-        vy = math.cos(start + ext)
+        vx, vy = ux, uy  # sin/cos of start + 0.0: the same values
+        if ext != 0.0:
+            vx = math.sin(start + ext)
+            vy = math.cos(start + ext)
         xi = rf[b, X, i] + ROBOT_HALF
         yi = rf[b, Y, i] + ROBOT_HALF
         for j in range(n):

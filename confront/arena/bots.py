@@ -71,7 +71,7 @@ def bot_kind(name: str | None) -> int:
     return BOT_NAMES.index(name) + 1
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _push(mem, b, i, base, lenpos, op, val):
     """Append an operation to a queue (base = M_HOPS or M_MOPS, lenpos = M_HLEN or M_MLEN)."""
     n = int(mem[b, i, lenpos])
@@ -81,7 +81,7 @@ def _push(mem, b, i, base, lenpos, op, val):
         mem[b, i, lenpos] = n + 1
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _start_handler(mem, b, i, prio):
     mem[b, i, M_FRESH] = 1.0
     mem[b, i, M_HPRIO] = prio
@@ -90,7 +90,7 @@ def _start_handler(mem, b, i, prio):
     mem[b, i, M_HSTART] = 0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _h(mem, b, i, op, val):
     _push(mem, b, i, M_HOPS, M_HLEN, op, val)
 
@@ -207,7 +207,7 @@ def _reverse(mem, b, i, cmd):
         mem[b, i, M_VAR + 4] = 1.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
     """A started operation is finished (blocking ops: remaining value 0)."""
     if not started:
@@ -225,7 +225,7 @@ def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
     return True
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, rem, gun_eq_radar):
     """Write an operation's commands; True if it takes the turn (blocking)."""
     if op == O_MOVE:
@@ -281,7 +281,7 @@ def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, 
     return False
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing,
             ev_fault, ev_hitby, ev_hitby_bearing, cmd):
     """Start the event handler of the highest-priority event of the last turn (if it may run)."""
@@ -419,7 +419,7 @@ def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_w
                 _h(mem, b, i, O_FIREASSIST, p)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _finish_handler(mem, b, i, rem):
     """A handler whose last operation just finished returns before this turn's events are dispatched.
 

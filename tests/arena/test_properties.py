@@ -52,6 +52,17 @@ def test_robots_stay_in_field_and_under_speed_limit(seed, scenario, maxv):
 @given(seed=st.integers(0, 2**31 - 1))
 def test_energy_bookkeeping_in_duels(seed):
     """Each turn: dE = -fire power + 3p per own hit - damage per hit taken - 0.6 per at-fault ram."""
+    _energy_bookkeeping(seed)
+
+
+def test_energy_bookkeeping_checks_hits():
+    """The bookkeeping check is not vacuous: these duels do hit (some random seeds never do, e.g. 1104828)."""
+    assert _energy_bookkeeping(0) > 0
+    assert _energy_bookkeeping(1104828) == 0
+
+
+def _energy_bookkeeping(seed: int) -> int:
+    """Random duels with the energy check of every turn; returns the number of bullet hits checked."""
     sc = get_scenario("1v1").replace(advanced=False, inactivity_time=100000)  # no wall damage, no drain
     arena = Arena(sc, 4, seed=seed % 1000)
     rng = np.random.default_rng(seed)
@@ -83,4 +94,4 @@ def test_energy_bookkeeping_in_duels(seed):
         np.testing.assert_allclose(s.energy[ok], expect[ok], atol=1e-9)
         if s.done.any():
             arena.reset(s.done)
-    assert checked_hits > 0  # the random duels do hit
+    return checked_hits

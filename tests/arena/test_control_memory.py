@@ -82,6 +82,14 @@ def test_memory_hand_case_stale_position_and_death() -> None:
     assert cmd[0, 0, 2] == pytest.approx(np.pi / 2)
     assert cmd[0, 0, 3] == pytest.approx(np.pi / 2 + np.deg2rad(20))
     assert np.isnan(cmd[0, 1, 2]) and cmd[0, 1, 3] == 2 * np.pi  # no known target: radar spins
+    # the state and features come from the same picture: east (right of a north heading: rel bin 1),
+    # heading bin 0, 300 px (bin 6 of 50 px); the true enemy at 360.6 px would be bin 7
+    tgt, disc, feats = observe(s.x, s.y, s.heading, s.energy, s.alive, s.team, env.field, ObservationConfig(),
+                               memory, seen)
+    assert tgt[0].tolist() == [1, -1] and disc[0, 0] == (1 * 4 + 0) * 20 + 6
+    assert feats[0, 0, 4] == pytest.approx(0.3) and feats[0, 0, 6] == pytest.approx(0.8)
+    true_disc = observe(s.x, s.y, s.heading, s.energy, s.alive, s.team, env.field, ObservationConfig())[1]
+    assert true_disc[0, 0] == (1 * 4 + 0) * 20 + 7
     # a dead enemy is forgotten (RobotDeathEvent)
     s.alive[0, 1] = False
     assert not perceive(s.x, s.y, s.energy, s.alive, s.team, memory, seen)[3][0, 0, 1]

@@ -133,7 +133,7 @@ class DMNNParams(LearnerParams):
     q_scale: float = 10.0
     td_clip: float = 5.0
     rate_units: str = "network"
-    output_init: str = "zero"
+    output_init: str = "uniform"
     softmax_units: str = "q"
     gamma: float = 0.9
     alpha: float = 0.1

@@ -25,7 +25,7 @@ KINDS: dict[str, tuple[type, dict[str, Any], Callable[..., Learner]]] = {
     "ssaq": (TabularParams, {}, TabularQ),
     "qlearning_egreedy": (TabularParams, _TD, TabularQ),
     "qlearning_dgreedy": (TabularParams, {**_TD, "exploration": "degreedy"}, TabularQ),
-    "dmnn": (DMNNParams, {}, DMNN),
+    "dmnn": (DMNNParams, {"output_init": "zero"}, DMNN),  # Q = 0 at the start (docs/learning.md)
     "random": (UniformParams, {}, UniformPolicy),
 }
 

@@ -14,7 +14,7 @@ import numpy as np
 from confront.arena.smdp import TeamBattleEnv
 from confront.config import load_toml
 from confront.experiments.spec import ExperimentConfig, config_from_dict
-from confront.experiments.train import Loop, Side, _run, load_model, scenario_of, smdp_config
+from confront.experiments.train import Loop, Side, load_model, scenario_of, smdp_config
 from confront.learning.base import Learner
 from confront.results import BattleResults, ScoreRow
 
@@ -44,8 +44,15 @@ def results_from_rows(rows: list[dict[str, Any]], names: tuple[str, str]) -> Bat
 
 def sim_evaluate(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seed: int,
                  td_model: str | None = None, battles: int = SIM_BATTLES) -> list[dict[str, Any]]:
-    """Play ``learner`` greedily (no exploration, no learning) against ``opponent`` in the simulator."""
-    env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=min(battles, rounds), seed=seed,
+    """Play ``learner`` greedily (no exploration, no learning) against ``opponent`` in the simulator.
+
+    The rounds are shared out over the battles beforehand (``rounds // battles``, one more for the first
+    ``rounds % battles``) and each battle's first rounds are kept: taking the first ``rounds`` rounds to
+    finish anywhere would favour short rounds (the longer ones still running are cut)."""
+    if rounds < 1:
+        raise ValueError(f"rounds must be >= 1, got {rounds}")
+    n_b = min(battles, rounds)
+    env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=n_b, seed=seed,
                         opponents=opponent, config=smdp_config(cfg))
     team = env.team_ids()
     side = Side(learner, ours=team == 0)
@@ -55,8 +62,15 @@ def sim_evaluate(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds:
         side.opponent, _ = load_model(td_model)
         side.theirs = team != 0
     loop = Loop(env, side, seed=seed, learning=False)
-    _run(loop, rounds, progress=False, desc="evaluate")
-    return loop.rows[:rounds]
+    quota = [rounds // n_b + (b < rounds % n_b) for b in range(n_b)]
+    per: list[list[dict[str, Any]]] = [[] for _ in range(n_b)]
+    while any(len(rows) < q for rows, q in zip(per, quota, strict=True)):
+        for row in loop.step():
+            per[row["battle"]].append(row)
+    out = [row for rows, q in zip(per, quota, strict=True) for row in rows[:q]]
+    for k, row in enumerate(out):
+        row["round"] = k + 1
+    return out
 
 
 def exported_policy(learner: Learner, cfg: ExperimentConfig) -> Any:

@@ -44,3 +44,28 @@ def test_evaluate_table_has_the_simulator_ratio_and_its_seed_range(tmp_path: Pat
     assert disjoint_seeds(1, 4, rounds=100) == [1, 17, 33, 49]
     with pytest.raises(ValueError, match="sim_seeds"):
         evaluate_cli(run, "sim", "SpinBot", rounds=2, seed=0, sim_seeds=0)
+
+
+def test_sim_evaluate_keeps_each_battles_first_rounds(tmp_path: Path) -> None:
+    from collections import Counter
+
+    cfg = load_experiment("demo", ["arena.scenario=1v1", "opponent.kind=Walls", "learner.kind=ssaq",
+                                   "train.rounds=4", "train.session_rounds=4", "train.checkpoint_every=4",
+                                   "train.replay=false", "arena.battles=4"])
+    run = tmp_path / "run"
+    train_run(cfg, run, progress=False)
+    learner, _ = load_model(run)
+    cfg = _run_config(run)
+    six = sim_evaluate(cfg, learner, "Walls", 6, 5, battles=4)
+    ten = sim_evaluate(cfg, learner, "Walls", 10, 5, battles=4)
+    # 6 rounds over 4 battles: 2, 2, 1, 1 whatever their lengths; 10: 3, 3, 2, 2
+    assert Counter(r["battle"] for r in six) == {0: 2, 1: 2, 2: 1, 3: 1}
+    assert Counter(r["battle"] for r in ten) == {0: 3, 1: 3, 2: 2, 3: 2}
+    assert [r["round"] for r in six] == [1, 2, 3, 4, 5, 6]
+    # the same seed replays the same battles: the shorter run is a prefix of each battle's rounds
+    for b in range(4):
+        short = [(r["turns"], r["score_ours"]) for r in six if r["battle"] == b]
+        long = [(r["turns"], r["score_ours"]) for r in ten if r["battle"] == b]
+        assert long[:len(short)] == short
+    with pytest.raises(ValueError, match="rounds"):
+        sim_evaluate(cfg, learner, "Walls", 0, 5)

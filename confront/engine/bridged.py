@@ -12,9 +12,10 @@ from confront.engine.bridge import BridgeServer, BridgeSettings, Policy
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 
 BRIDGE_BOT = "confront.BridgeBot*"
-# robot time per turn for bridged battles: no skipped turns in 100 rounds at 30 ms on our 2-core machine
-# (11 at 10 ms), see docs/engine.md
-BRIDGE_CPU_CONSTANT_MS = 30.0
+# robot time per turn for bridged battles. 100 bridged rounds on our loaded 2-core machine skipped 10-35 turns
+# at 30 ms and 2 at 100 ms (docs/engine.md); a larger value costs almost nothing: the round-start wait is
+# capped at 10 s per occurrence from 34 ms on (robocode-facts.md section 10)
+BRIDGE_CPU_CONSTANT_MS = 100.0
 
 
 def bridge_timeout_ms(cpu_constant_ms: float) -> int:
@@ -85,10 +86,9 @@ def run_bridged_battle(
     The robots connect before their first action and ask ``policy`` in turns 1, 1 + every, ... (the paper's
     SMDP step T); the commands keep running in between. ``controller``: the robots run this fixed gun/radar
     controller themselves every turn (the answers' gun, radar and fire are then ignored), so a policy that
-    only picks moves costs one round trip per ``every`` turns. ``history``: the robots send every turn's energies
-with the next observation and at the round's end; ``lead``: ask that many turns ahead (``BridgeSettings``).
-    ``extra_robots``: robot jars or folders to add
-    (e.g. exported PolicyBot opponents).
+    only picks moves costs one round trip per ``every`` turns. ``history``: the robots send every turn's
+    energies with the next observation and at the round's end; ``lead``: they ask that many turns ahead (see
+    ``BridgeSettings``). ``extra_robots``: robot jars or folders to add (e.g. exported PolicyBot opponents).
     """
     opts = options or EngineOptions(cpu_constant_ms=BRIDGE_CPU_CONSTANT_MS)
     tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)

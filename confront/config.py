@@ -95,6 +95,8 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
         allowed = " or ".join(_type_name(a) for a in args)
         raise ConfigError(f"{key} = {value!r} has the wrong type: expected {allowed}")
     if origin is typing.Literal:
+        if isinstance(value, bool) and str(value).lower() in args:  # --set k=true parses as a bool
+            return str(value).lower()
         if value not in args:
             raise ConfigError(f"{key} = {value!r} is not allowed: use one of {', '.join(map(repr, args))}")
         return value

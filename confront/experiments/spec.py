@@ -25,6 +25,8 @@ class ArenaSection:
     decision_turns: int = field(10, ge=1, le=500, doc="T: engine turns each macro action is held (SMDP step)")
     fire_power_actions: bool = field(False, doc="extended action set: 4 moves x 3 bullet powers")
     target: Literal["nearest", "weakest"] = "nearest"
+    sensing: Literal["scanned", "true"] = field(
+        "scanned", doc="what a tank knows of enemies: their last scan (a real robot's view) or the true state")
 
 
 @dataclass
@@ -45,7 +47,8 @@ class OpponentSection:
 class LearnerSection:
     """The learning team's method (paper §3-4; Table 2)."""
 
-    kind: Literal["dmnn", "ssaq"] = "dmnn"
+    kind: Literal["dmnn", "ssaq", "random"] = field(
+        "dmnn", doc="dmnn (§4), ssaq (tabular, §3), or random: uniform moves, a reference that never learns")
     learning_rate: Literal["fuzzy", "fixed"] = field("fuzzy", doc="RL learning rate: fuzzy (Eq. 11-17) or fixed alpha")
     alpha: float = field(0.1, gt=0.0, le=1.0, doc="fixed RL learning rate (Table 2: 0.1)")
     gamma: float = field(0.9, ge=0.0, le=1.0, doc="discount (Table 2: 0.9)")

@@ -51,7 +51,7 @@ def smdp_config(cfg: ExperimentConfig) -> SMDPConfig:
     from confront.arena.observe import ObservationConfig
 
     return SMDPConfig(turns_per_step=cfg.arena.decision_turns, fire_power_actions=cfg.arena.fire_power_actions,
-                      observation=ObservationConfig(target=cfg.arena.target))
+                      observation=ObservationConfig(target=cfg.arena.target, sensing=cfg.arena.sensing))
 
 
 def build_learner(cfg: ExperimentConfig, n_features: int, n_actions: int) -> Learner:
@@ -61,6 +61,8 @@ def build_learner(cfg: ExperimentConfig, n_features: int, n_actions: int) -> Lea
                   exploration="boltzmann", t_max=lc.t_max, t_min=lc.t_min, eta=lc.eta)
     if lc.kind == "ssaq":
         return make_learner("ssaq", n_states=320, **common)
+    if lc.kind == "random":
+        return make_learner("random", n_actions=n_actions)
     return make_learner("dmnn", n_inputs=n_features, observation="features", hidden=lc.hidden, awm=lc.awm,
                         momentum=lc.momentum, nn_rate=lc.nn_rate, output=lc.output, q_scale=lc.q_scale,
                         td_clip=lc.td_clip, init_seed=cfg.train.seed, **common)
@@ -240,7 +242,7 @@ def td_team(cfg: ExperimentConfig, n_actions: int, progress: bool = False) -> tu
         return learner, Path(oc.model)
     key = json.dumps({"opponent": to_dict(oc), "decision_turns": cfg.arena.decision_turns,
                       "fire_power_actions": cfg.arena.fire_power_actions, "target": cfg.arena.target,
-                      "seed": cfg.train.seed, "version": 1}, sort_keys=True)
+                      "sensing": cfg.arena.sensing, "seed": cfg.train.seed, "version": 2}, sort_keys=True)
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]
     cache = Path(os.environ.get("CONFRONT_CACHE", Path.home() / ".cache" / "confront")) / "td" / digest
     if (cache / "model.json").exists():

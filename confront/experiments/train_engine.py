@@ -123,6 +123,8 @@ def _opponent(cfg: ExperimentConfig, obs_cfg: ObservationConfig, robots: Path,
 def _check(cfg: ExperimentConfig) -> None:
     if cfg.arena.scenario not in SCENARIO_SIZES:
         raise ValueError(f"arena.scenario = {cfg.arena.scenario!r}: the engine plays {sorted(SCENARIO_SIZES)}")
+    if cfg.arena.sensing != "scanned":
+        raise ValueError("arena.sensing = 'true' is not possible in the engine (robots know what they scanned)")
     if cfg.arena.fire_power_actions:
         raise ValueError("arena.fire_power_actions = true is not supported in the engine (4 moves only)")
     if cfg.opponent.kind != "td":

@@ -107,3 +107,20 @@ def test_corrupt_checkpoint_is_refused_and_kept(reference: tuple[Path, Path], tm
     assert resumed.returncode == 2
     assert "corrupt or truncated" in resumed.stderr and "Traceback" not in resumed.stderr
     assert sorted((p.name, p.stat().st_size) for p in (out / "checkpoints").rglob("*")) == before
+
+
+def test_random_reference_and_true_sensing_are_config_choices(tmp_path: Path,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import smdp_config, train_run
+
+    monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path / "cache"))
+    small = ["train.rounds=8", "train.session_rounds=4", "arena.battles=2", "opponent.pretrain_rounds=2",
+             "train.replay=false"]
+    cfg = load_experiment("demo", small + ["learner.kind=random", "arena.sensing=true"])
+    assert cfg.arena.sensing == "true" and smdp_config(cfg).observation.sensing == "true"
+    summary = train_run(cfg, tmp_path / "run", progress=False)
+    assert summary["rounds"] == 8 and summary["learner"] == {"temperature": float("inf"), "updates": 0.0}
+    # a different sensing trains (and caches) a different TD team
+    again = train_run(load_experiment("demo", small + ["learner.kind=random"]), tmp_path / "run2", progress=False)
+    assert again["td_model"] != summary["td_model"]

@@ -205,9 +205,20 @@ def _session_figures(outcome: Outcome, fig_dir: Path, jobs: dict[str, list[Job]]
                                                    for a, f in folders.items()}))
 
 
+RANDOM_ARM = "random moves"  # reference arm beyond the paper: uniform moves, same gun controller, never learns
+
+
+def _beats_random(arm: str, folders: dict[str, list[Path]], tail: int, rng: np.random.Generator) -> Claim:
+    """Beyond the paper: does the trained arm score more than a team that moves at random?"""
+    return compare(f"beyond the paper: {arm} scores a higher ratio than random moves", "-",
+                   _tail_values(folders[arm], "score_ratio", tail),
+                   _tail_values(folders[RANDOM_ARM], "score_ratio", tail), arm, RANDOM_ARM, rng)
+
+
 def awm(seeds: int, out: Path, rng: np.random.Generator, tail: int) -> tuple[list[Job], Callable[[], Outcome]]:
     jobs = _arm_jobs("awm", "awm", {"NN with AWM": ("learner.awm=true",),
-                                    "NN without AWM": ("learner.awm=false",)}, seeds, out)
+                                    "NN without AWM": ("learner.awm=false",),
+                                    RANDOM_ARM: ("learner.kind=\"random\"",)}, seeds, out)
 
     def analyse() -> Outcome:
         o = Outcome("awm")
@@ -228,6 +239,7 @@ def awm(seeds: int, out: Path, rng: np.random.Generator, tail: int) -> tuple[lis
         o.claims.append(compare("NN with AWM has a higher defensive score", "Fig. 12",
                                 _tail_values(w, "defensive_ours", tail), _tail_values(wo, "defensive_ours", tail),
                                 "with", "without", rng, what="defensive score per round"))
+        o.claims.append(_beats_random("NN with AWM", folders, tail, rng))
         return o
 
     return [j for js in jobs.values() for j in js], analyse
@@ -238,6 +250,7 @@ def fuzzy(seeds: int, out: Path, rng: np.random.Generator, tail: int) -> tuple[l
         "FLM": ("learner.learning_rate=\"fuzzy\"",),
         "LM-0.2": ("learner.learning_rate=\"fixed\"", "learner.alpha=0.2"),
         "LM-0.95": ("learner.learning_rate=\"fixed\"", "learner.alpha=0.95"),
+        RANDOM_ARM: ("learner.kind=\"random\"",),
     }, seeds, out)
 
     def analyse() -> Outcome:
@@ -261,6 +274,7 @@ def fuzzy(seeds: int, out: Path, rng: np.random.Generator, tail: int) -> tuple[l
             o.claims.append(level_claim(f"{arm}'s score ratio stays around 0.7", "Fig. 14", other, 0.7, 0.05, rng,
                                         arm))
             o.claims.append(compare(f"FLM scores a higher ratio than {arm}", "Fig. 14", flm, other, "FLM", arm, rng))
+        o.claims.append(_beats_random("FLM", folders, tail, rng))
         return o
 
     return [j for js in jobs.values() for j in js], analyse

@@ -44,6 +44,12 @@ def test_arms_ran_with_their_settings(tiny: Path) -> None:
     without = tomllib.loads((runs / "nn-without-awm" / "seed-0" / "config.toml").read_text())
     assert with_awm["learner"]["awm"] is True and without["learner"]["awm"] is False
     assert with_awm["train"]["seed"] == 1 and with_awm["train"]["rounds"] == 8
+    for exp in ("awm", "fuzzy"):  # the reference arm beyond the paper: random moves, never learns
+        ref = tiny / exp / "runs" / "random-moves" / "seed-0"
+        assert tomllib.loads((ref / "config.toml").read_text())["learner"]["kind"] == "random"
+        assert json.loads((ref / "summary.json").read_text())["learner"]["updates"] == 0
+        claims = json.loads((tiny / exp / "claims.json").read_text())
+        assert any("than random moves" in c["text"] for c in claims)
     lm = tomllib.loads((tiny / "fuzzy" / "runs" / "lm-0-95" / "seed-0" / "config.toml").read_text())
     assert lm["learner"]["learning_rate"] == "fixed" and lm["learner"]["alpha"] == 0.95
     # the curriculum: 4v6 with TF starts from the 4v4 source run, 4v10 with TF from the 4v6 with-TF run

@@ -58,6 +58,8 @@ M_MOPS = M_HOPS + 2 * Q
 M_STATIC = M_MOPS + 2 * Q  # kept across rounds (Corners' corner)
 M_SIZE = M_STATIC + 2
 
+# play(): battle chunks per worker thread (a thread on a free core takes more when the other core is busy)
+_CHUNKS_PER_THREAD = 4
 P_SCAN, P_BULLET, P_WALL, P_ROBOT = 10.0, 20.0, 30.0, 40.0
 DEG = math.pi / 180.0
 
@@ -653,7 +655,7 @@ class ScriptedBots:
         sc = a.scenario
         tail = (cmd, params, scratch_i, scratch_f, a._fixed, a._has_fixed, float(sc.width), float(sc.height))
         nb, workers = a.n_battles, a.threads
-        size = -(-nb // workers) if nb >= 2 * workers and workers > 1 else nb
+        size = -(-nb // (_CHUNKS_PER_THREAD * workers)) if nb >= 2 * workers and workers > 1 else nb
         bounds = [(lo, min(nb, lo + size)) for lo in range(0, nb, size)]
 
         def run(lo: int, hi: int) -> int:

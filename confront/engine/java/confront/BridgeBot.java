@@ -404,6 +404,10 @@ public class BridgeBot extends TeamRobot {
         finished = true;
         if (!failed && socket != null) {
             try {
+                if (pending) {
+                    in.readLine();  // the answer to a request sent ahead (lead): closing with it unread resets
+                    pending = false;
+                }
                 // with this round's round-trip and work-time statistics (a dead robot's output is not collected)
                 if (keepHistory) {
                     record();  // the state this robot ends the round in

@@ -154,8 +154,9 @@ def test_history_brings_every_turn_between_decisions(install, lead: int) -> None
     for hs in records.values():
         times = [h.time for h in hs]
         assert times[0] == 0 and all(b > a for a, b in zip(times, times[1:], strict=False))
-        if not res.run.skipped_turns:
-            assert times == list(range(len(times)))  # every turn exactly once
+        if not res.run.skipped_turns:  # every turn exactly once; a turn skipped just before a robot's death
+            # goes unreported (a dead robot's output is not collected), hence a possible gap before the last
+            assert times[:-1] == list(range(len(times) - 1)) and times[-1] - times[-2] in (1, 2)
         assert hs[0].energy == 100.0 and hs[0].target == ""  # nothing scanned before turn 1
         assert hs[20].target == "sample.SpinBot"  # scanned within 20 turns: the only enemy
         assert {h.target for h in hs} == {"", "sample.SpinBot"}

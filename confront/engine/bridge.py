@@ -393,7 +393,8 @@ class BridgeServer:
                     else:
                         t0 = time.perf_counter()
                         obs = parse_observation(line, hello)
-                        with self._lock:
+                        parsed = time.perf_counter()
+                        with self._lock:  # waiting here (team-mates' decisions) is counted nowhere
                             t1 = time.perf_counter()
                             action = self.policy(obs)
                             t2 = time.perf_counter()
@@ -402,7 +403,7 @@ class BridgeServer:
                         with self._lock:
                             self.stats.decisions += 1
                             self.stats.policy_s += t2 - t1
-                            self.stats.handling_s += (t1 - t0) + (t3 - t2)
+                            self.stats.handling_s += (parsed - t0) + (t3 - t2)
         except OSError as err:
             if not self._stop.is_set():
                 self._error(f"{hello['name'] if hello else '?'}: connection: {err}")

@@ -28,8 +28,10 @@ def evaluate_policy(
     """Play ``policy`` for our side of ``scenario`` and return (results, our score ratio).
 
     ``mode="export"`` plays the compiled PolicyBot (no Python in the loop); ``"bridge"`` lets the Python
-    twin decide every turn through the bridge. Both decide identically on identical observations.
-    ``cpu_constant_ms`` defaults to 30 ms for the bridge (no skipped turns) and 10 ms for the export.
+    twin pick the move every ``policy.step_turns`` turns through the bridge, with the gun/radar controller run
+    by the robot in Java (the exported robot's code) every turn. Both decide identically on identical
+    observations. ``cpu_constant_ms`` defaults to ``BRIDGE_CPU_CONSTANT_MS`` (100 ms, fewer skipped turns)
+    for the bridge and 10 ms for the export.
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
@@ -38,7 +40,7 @@ def evaluate_policy(
     if mode == "bridge":
         spec = scenario_battle(scenario, BRIDGE_BOT.rstrip("*"), opponents, rounds=rounds)
         spec = _single_star(spec, BRIDGE_BOT)
-        res = run_bridged_battle(spec, policy, opts).run.results
+        res = run_bridged_battle(spec, policy, opts, every=policy.step_turns, controller=policy.control).run.results
     else:
         with tempfile.TemporaryDirectory(prefix="confront-eval-") as tmp:
             folder = export_robot(policy, Path(tmp) / "robots")

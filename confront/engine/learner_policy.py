@@ -1,33 +1,58 @@
 """A learner (``confront.learning``) as a bridge policy: evaluate it, or train it live in the real engine.
 
-Each BridgeBot tank picks one of the paper's four moves every ``step_turns`` turns with the learner
-(parameter sharing: one learner for every tank), the fixed gun/radar controller aims and fires every turn,
-the per-turn reward is the paper's Eq. 35 on the tank's and its target's energies, and with
-``train=True`` every finished SMDP step is passed to ``learner.learn`` at once (``done`` when the tank
-died or the round ended).
+Run with the bridge's decision mode (``run_bridged_battle(..., **policy.bridge_kwargs())``: ``every`` =
+``step_turns``, the fixed gun/radar ``controller`` in Java every turn, ``history=True``): each BridgeBot tank
+asks only in its decision turns (1, 1 + T, ...), and the learner picks one of the paper's four moves
+(parameter sharing: one learner for every tank). The per-turn reward is the paper's Eq. 35, computed from the
+robot's per-turn energy records (``Observation.history``, :class:`~confront.engine.bridge.TurnEnergy`) on the
+tank's energy and its target's (the nearest enemy by last scans, as the Java controller picks it). With
+``train=True`` each finished SMDP step (the decision, the T per-turn rewards r_t..r_{t+T-1}, the next
+decision's observation) is passed to ``learner.learn`` at once; ``end_episode`` (death or round end) adds the
+last rewards and learns the open step as terminal.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from confront.arena.control import ControlConfig
+from confront.arena.control import ControlConfig, move_commands
 from confront.arena.observe import ObservationConfig, reward_eq35
-from confront.engine.bridge import Observation
+from confront.engine.bridge import Observation, TurnEnergy
 from confront.engine.export import ExportedPolicy
 from confront.learning.base import Learner, Transition
 
 
+def history_rewards(history: Sequence[TurnEnergy], own_prev: float | None,
+                    guard: float = 1.0) -> tuple[list[float], float | None]:
+    """Eq. 35 per history record, and the last record's own energy (to carry to the next call).
+
+    ``own_prev`` is the own energy of the record before ``history[0]`` (None: there was none, so the first
+    record only starts the chain). A record without a target (``target == ""``) earns 0.
+    """
+    rewards: list[float] = []
+    for h in history:
+        if own_prev is not None:
+            # Eq. 35 on (own, target) energies at the previous record and at this one; no target: 0
+            r = 0.0 if h.target == "" else float(reward_eq35(own_prev, h.energy, h.target_previous,
+                                                             h.target_energy, guard))
+            rewards.append(r)
+        own_prev = h.energy
+    return rewards, own_prev
+
+
 @dataclass
-class _Pending:
-    obs: np.ndarray
-    action: int
+class _Tank:
+    """One tank's open SMDP step in one round (``obs`` None before its first decision)."""
+
+    obs: np.ndarray | None = None
+    action: int = 0
     rewards: list[float] = field(default_factory=list)
-    own: float = 100.0
-    enemy: dict[str, float] = field(default_factory=dict)
+    own: float | None = None  # own energy at the last history record
 
 
 class LearnerPolicy:
@@ -51,61 +76,59 @@ class LearnerPolicy:
         self.explore = explore
         self.step_turns = step_turns
         self.obs_config = observation or ObservationConfig()
-        # the twin supplies observations and the gun/radar controller; its Q table is never used
+        self.control = control or ControlConfig()
+        # the twin builds the learner's observation; its Q table is never used
         self._twin = ExportedPolicy("qtable", q=np.zeros((320, 4)), observation=self.obs_config,
-                                    control=control or ControlConfig(), step_turns=step_turns)
-        self._pending: dict[tuple[str, int], _Pending] = {}
+                                    control=self.control, step_turns=step_turns)
+        self._tanks: dict[tuple[str, int], _Tank] = {}
         self.updates = 0
         self.decisions = 0
-        self.rewards: list[float] = []
+        self.reward_turns = 0
+        self.reward_sum = 0.0
+        self.reward_max = -math.inf
 
-    def _target_energy(self, obs: Observation) -> tuple[str, float] | None:
-        es = obs.enemies()
-        if not es:
-            return None
-        t = min(es, key=lambda s: (s.x - obs.x) ** 2 + (s.y - obs.y) ** 2)
-        return t.name, t.energy
+    def bridge_kwargs(self) -> dict[str, Any]:
+        """The ``run_bridged_battle`` settings this policy needs: a decision every ``step_turns`` turns, the
+        gun/radar controller in Java, per-turn energy history."""
+        return {"every": self.step_turns, "controller": self.control, "history": True}
 
-    def _learn(self, p: _Pending, next_obs: np.ndarray, done: bool) -> None:
-        if self.train and p.rewards:
-            rewards = np.array([p.rewards])
-            self.learner.learn(Transition(p.obs, np.array([p.action]), rewards, next_obs, np.array([done])))
+    def _add_rewards(self, tank: _Tank, history: Sequence[TurnEnergy]) -> None:
+        rewards, tank.own = history_rewards(history, tank.own, self.obs_config.reward_guard)
+        if tank.obs is not None:  # rewards before the first decision belong to no step
+            tank.rewards += rewards
+            self.reward_turns += len(rewards)
+            self.reward_sum += sum(rewards)
+            self.reward_max = max([self.reward_max, *rewards])
+
+    def _learn(self, tank: _Tank, next_obs: np.ndarray, done: bool) -> None:
+        if self.train and tank.obs is not None and tank.rewards:
+            self.learner.learn(Transition(tank.obs, np.array([tank.action]), np.array([tank.rewards]), next_obs,
+                                          np.array([done])))
             self.updates += 1
 
     def __call__(self, obs: Observation) -> tuple[float, float, float, float, float]:
-        key = (obs.robot, obs.round)
-        p = self._pending.get(key)
-        tgt = self._target_energy(obs)
-        if p is not None:
-            # Eq. 35 for the turn that just ended, against the current target's energy change
-            if tgt is not None:
-                prev_enemy = p.enemy.get(tgt[0], tgt[1])
-                r = float(reward_eq35(np.array(p.own), np.array(obs.energy), np.array(prev_enemy),
-                                      np.array(tgt[1]), self.obs_config.reward_guard))
-            else:
-                r = 0.0
-            p.rewards.append(r)
-            self.rewards.append(r)
-            p.own = obs.energy
-            p.enemy = {s.name: s.energy for s in obs.enemies()}
-        ahead = turn = math.nan
-        if (obs.turn - 1) % self.step_turns == 0:
-            x = self._twin.learner_observation(obs, self.learner.observation)
-            if p is not None:
-                self._learn(p, x, done=False)
-            action = int(self.learner.act(x, self.rng, explore=self.explore)[0])
-            self.decisions += 1
-            self._pending[key] = _Pending(x, action, own=obs.energy,
-                                          enemy={s.name: s.energy for s in obs.enemies()})
-            c = self._twin.control
-            ahead, turn = {0: (c.move_distance, 0.0), 1: (-c.move_distance, 0.0),
-                           2: (c.turn_move_distance, c.turn_angle),
-                           3: (c.turn_move_distance, -c.turn_angle)}[action]
-        gun, radar, fire = self._twin.gun_radar(obs)
-        return (ahead, turn, gun, radar, fire)
+        """A decision turn: learn the step that ends here, pick the next move; gun, radar, fire are NaN (the
+        robot's controller aims)."""
+        tank = self._tanks.setdefault((obs.robot, obs.round), _Tank())
+        if tank.obs is not None and not obs.history:
+            raise ValueError(f"no energy history in {obs.robot}'s observation of turn {obs.turn}: "
+                             "run the bridge with history=True (LearnerPolicy.bridge_kwargs())")
+        self._add_rewards(tank, obs.history)
+        x = self._twin.learner_observation(obs, self.learner.observation)
+        self._learn(tank, x, done=False)
+        tank.obs, tank.action, tank.rewards = x, int(self.learner.act(x, self.rng, explore=self.explore)[0]), []
+        self.decisions += 1
+        dist, turn = move_commands(np.array([tank.action]), self.control)
+        return (float(dist[0]), float(turn[0]), math.nan, math.nan, math.nan)
 
-    def end_episode(self, robot: str, round_: int) -> None:
-        """The tank died or its round ended: learn its last step as terminal."""
-        p = self._pending.pop((robot, round_), None)
-        if p is not None:
-            self._learn(p, p.obs, done=True)
+    def end_episode(self, robot: str, round_: int, history: Sequence[TurnEnergy] = ()) -> None:
+        """The tank died or its round ended: add the last turns' rewards and learn its open step as terminal."""
+        tank = self._tanks.pop((robot, round_), None)
+        if tank is not None and tank.obs is not None:
+            self._add_rewards(tank, history)
+            self._learn(tank, tank.obs, done=True)
+
+    def end_all(self) -> None:
+        """Learn every step still open as terminal (a battle ended without a tank's end message)."""
+        for robot, round_ in list(self._tanks):
+            self.end_episode(robot, round_)

@@ -1,11 +1,12 @@
 """Training a config's learner live in the real engine (``confront train --engine robocode``).
 
-One battle of ``train.rounds`` rounds: our side is a team of BridgeBots sharing one learner through the bridge
-(parameter sharing), the opponents are sample robots or the frozen TD team exported as PolicyBots. The run
-folder is the simulator's: config.toml, metrics/rounds.csv (same columns), metrics/sessions.csv, model/,
-plots/, summary.json (same keys, plus the engine's skipped turns and bridge failures), and engine/results.txt
-and results.csv (the engine's results for the whole battle). Per-round score parts come from the runner's
-``round_scores`` (each robot's battle totals at each round's end, differenced).
+Our side is a team of BridgeBots sharing one learner through the bridge (parameter sharing; ``LearnerPolicy``:
+a round trip only every ``arena.decision_turns`` turns, the gun/radar controller in Java, the Eq. 35 rewards from
+the robots' per-turn energy history), the opponents are sample robots or the frozen TD team exported as
+PolicyBots. The run folder is the simulator's: config.toml, metrics/rounds.csv (same columns),
+metrics/sessions.csv, model/, plots/, summary.json (same keys, plus the engine's skipped turns and bridge
+failures), and engine/battle-NNN/results.txt and results.csv (the engine's results for each battle). Per-round
+score parts come from the runner's ``round_scores`` (each robot's battle totals at each round's end, differenced).
 Curriculum transfer wraps the learner in ``TransferPolicy`` (Eq. 34) as the simulator does. The TD team plays
 its frozen table (``opponent.learning`` is ignored).
 
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -32,7 +34,7 @@ from confront.arena.state import SCORE_PARTS
 from confront.checkpoint import CheckpointError
 from confront.config import load_toml, to_dict
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
-from confront.engine.bridge import Action, Observation
+from confront.engine.bridge import Action, Observation, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
 from confront.engine.evaluate import _single_star
 from confront.engine.export import ExportedPolicy, export_robot
@@ -161,19 +163,13 @@ class _Progress:
             self.bar.update(self.done + obs.round - self.bar.n)
         return self.policy(obs)
 
-    def end_episode(self, robot: str, round_: int) -> None:
-        self.policy.end_episode(robot, round_)
+    def end_episode(self, robot: str, round_: int, history: Sequence[TurnEnergy] = ()) -> None:
+        self.policy.end_episode(robot, round_, history)
 
 
 def _battle(cfg: ExperimentConfig, opponent: str, rounds: int) -> BattleSpec:
     spec = scenario_battle(cfg.arena.scenario, BRIDGE_BOT.rstrip("*"), opponent, rounds=rounds)
     return _single_star(_single_star(spec, BRIDGE_BOT), POLICY_BOT)
-
-
-def _end_battle(policy: LearnerPolicy) -> None:
-    """Learn every step still open when a battle ends as terminal (rounds restart at 0 in the next battle)."""
-    for robot, round_ in list(policy._pending):
-        policy.end_episode(robot, round_)
 
 
 def _checkpoint(run: Run, learner: Learner, policy: LearnerPolicy, state: dict[str, Any]) -> None:
@@ -256,8 +252,8 @@ def train_in_engine(
                 opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * rounds)
                 res: BridgedRun = run_bridged_battle(_battle(cfg, opponent, rounds),
                                                      _Progress(policy, bar, state["rounds_done"]), opts,
-                                                     extra_robots=extra)
-                _end_battle(policy)
+                                                     extra_robots=extra, **policy.bridge_kwargs())
+                policy.end_all()  # rounds restart at 0 in the next battle
                 rows = round_rows(res.run.summary["round_scores"])
                 for r in rows:
                     r["battle"], r["round"] = state["battles"], r["round"] + state["rounds_done"]

@@ -69,3 +69,22 @@ def test_sim_evaluate_keeps_each_battles_first_rounds(tmp_path: Path) -> None:
         assert long[:len(short)] == short
     with pytest.raises(ValueError, match="rounds"):
         sim_evaluate(cfg, learner, "Walls", 0, 5)
+
+
+@pytest.mark.engine
+def test_engine_bridge_mode_plays_the_exported_robots_battle(install) -> None:
+    """The Python twin asked every T turns, the controller in Java: the same battle as the compiled robot."""
+    import numpy as np
+
+    from confront.engine.evaluate import evaluate_policy
+    from confront.engine.export import ExportedPolicy
+
+    policy = ExportedPolicy("qtable", q=np.random.default_rng(4).normal(size=(320, 4)), step_turns=10)
+    exported, r_export = evaluate_policy(policy, "1v1", "SittingDuck", rounds=1, seed=1, mode="export")
+    bridged, r_bridge = evaluate_policy(policy, "1v1", "SittingDuck", rounds=1, seed=1, mode="bridge")
+    ours = next(c for c in bridged.contestants if c.name.startswith("confront.BridgeBot"))
+    ref = next(c for c in exported.contestants if c.name.startswith("confront.PolicyBot"))
+    assert ours.bullet_dmg > 0 and ours.firsts == 1  # it aims with the robot's own controller and wins
+    # identical seeded battle (no skipped turn expected at the bridge's 100 ms per turn on a 1-round battle)
+    assert (ours.total, ours.bullet_dmg, ours.survival) == (ref.total, ref.bullet_dmg, ref.survival)
+    assert r_bridge == pytest.approx(r_export)

@@ -1,4 +1,4 @@
-"""Learners as bridge policies: SMDP steps, Eq. 35 rewards, live training in the engine."""
+"""Learners as bridge policies: SMDP steps, Eq. 35 rewards from the robots' energy history, live training."""
 
 from __future__ import annotations
 
@@ -7,36 +7,88 @@ import math
 import numpy as np
 import pytest
 
+from confront.arena.control import ControlConfig, move_commands
 from confront.engine.battle import BattleSpec
-from confront.engine.bridge import Observation, Scan
+from confront.engine.bridge import Observation, Scan, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
-from confront.engine.learner_policy import LearnerPolicy
+from confront.engine.export import ExportedPolicy
+from confront.engine.learner_policy import LearnerPolicy, history_rewards
+from confront.learning.base import Transition
 from confront.learning.tabular import TabularQ
 
 
-def _obs(turn: int, own: float, enemy: float) -> Observation:
-    scan = Scan("e", turn, False, 0.0, 200.0, 0.0, 0.0, enemy, 400.0, 500.0)
-    return Observation("me", (), 0, turn, 400.0, 300.0, 0.0, 0.0, 0.0, 0.0, own, 1.0, 1, 0.0, 800.0, 600.0, (scan,))
+def _obs(turn: int, own: float, enemy: float, history: tuple[TurnEnergy, ...], round_: int = 0,
+         ex: float = 400.0) -> Observation:
+    scan = Scan("e", turn, False, 0.0, 200.0, 0.0, 0.0, enemy, ex, 500.0)
+    return Observation("me", (), round_, turn, 400.0, 300.0, 0.0, 0.0, 0.0, 0.0, own, 1.0, 1, 0.0, 800.0, 600.0,
+                       (scan,), history=history)
 
 
-def test_smdp_steps_and_eq35_rewards() -> None:
-    learner = TabularQ()
+def _action(move: tuple[float, ...]) -> int:
+    """The move id whose (distance, body turn) the answer carries."""
+    dist, turn = move_commands(np.arange(4), ControlConfig())
+    (hit,) = [a for a in range(4) if (dist[a], turn[a]) == (move[0], move[1])]
+    return hit
+
+
+def test_history_rewards_by_hand() -> None:
+    hist = (TurnEnergy(0, 100.0, "", 0.0, 0.0),  # turn 0: no previous record, no target
+            TurnEnergy(1, 97.0, "e", 100.0, 100.0),  # we lost 3, the target nothing: (-3 - 0) * 0 / 3 = 0
+            TurnEnergy(2, 97.0, "e", 100.0, 84.0),  # target lost 16, gap |97 - 100| = 3: (0 + 16) * 16 / 3
+            TurnEnergy(3, 95.0, "", 0.0, 0.0))  # no target: 0
+    rewards, own = history_rewards(hist, None)
+    assert rewards == pytest.approx([0.0, 256 / 3, 0.0]) and own == 95.0
+    # the first record's reward uses the own energy carried from the previous call: (100 - 103) - (40 - 50) = 7,
+    # times |50 - 40| = 10, over |103 - 50| = 53
+    rewards, own = history_rewards((TurnEnergy(5, 100.0, "e", 50.0, 40.0),), 103.0)
+    assert rewards == pytest.approx([70 / 53]) and own == 100.0
+    # the denominator is floored at the guard: (0 + 2) * 2 / max(0.5, guard)
+    assert history_rewards((TurnEnergy(1, 50.0, "e", 50.5, 48.5),), 50.0)[0] == pytest.approx([4.0])
+    assert history_rewards((TurnEnergy(1, 50.0, "e", 50.5, 48.5),), 50.0, guard=0.25)[0] == pytest.approx([8.0])
+    assert history_rewards((), 42.0) == ([], 42.0)
+
+
+def test_smdp_steps_learn_the_history_rewards() -> None:
+    learner, ref = TabularQ(), TabularQ()
+    twin = ExportedPolicy("qtable", q=np.zeros((320, 4)))
     pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2)
-    a1 = pol(_obs(1, 100.0, 100.0))  # decision turn
-    assert not math.isnan(a1[0]) and pol.decisions == 1
-    a2 = pol(_obs(2, 97.0, 100.0))  # we lost 3: Eq. 35 = (-3 - 0) * 0 / ... = 0
-    assert math.isnan(a2[0]) and math.isnan(a2[1])
-    pol(_obs(3, 97.0, 84.0))  # enemy lost 16, energy gap |97 - 100| = 3: (0 + 16) * 16 / 3
-    assert pol.rewards == pytest.approx([0.0, 16 * 16 / 3])
-    assert pol.updates == 1 and learner.step == 1  # the first SMDP step (T = 2) was learned
-    pol.end_episode("me", 0)  # the new step has no turn yet: nothing to learn
-    assert pol.updates == 1
-    pol(_obs(3, 97.0, 84.0))  # round 0 was ended above, so this starts a fresh step
-    pol(_obs(4, 97.0, 84.0))
-    pol.end_episode("me", 0)  # a one-turn terminal step
+    assert pol.bridge_kwargs() == {"every": 2, "controller": pol.control, "history": True}
+    o1 = _obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),))
+    m1 = pol(o1)  # first decision: nothing to learn yet
+    assert pol.decisions == 1 and pol.updates == 0 and pol.reward_turns == 0
+    assert all(math.isnan(v) for v in m1[2:])  # gun, radar, fire: the robot's own controller
+    o3 = _obs(3, 97.0, 84.0, (TurnEnergy(1, 97.0, "e", 100.0, 100.0), TurnEnergy(2, 97.0, "e", 100.0, 84.0)),
+              ex=100.0)
+    m3 = pol(o3)
+    s1, s3 = (twin.learner_observation(o, "discrete") for o in (o1, o3))
+    assert s1[0] != s3[0]  # the enemy moved to another sector: the step's next state is the new observation
+    # the step (s1, a1, r_1..r_2, s3) was learned as the simulator's SMDP step: the same update as by hand
+    ref.learn(Transition(s1, np.array([_action(m1)]), np.array([[0.0, 256 / 3]]), s3, np.array([False])))
+    assert pol.updates == 1 and learner.step == 1
+    np.testing.assert_array_equal(learner.q, ref.q)
+    # death: the last record's reward (-2 own, target unchanged: 0) closes the step as terminal
+    pol.end_episode("me", 0, (TurnEnergy(3, 95.0, "e", 84.0, 84.0),))
+    ref.learn(Transition(s3, np.array([_action(m3)]), np.array([[0.0]]), s3, np.array([True])))
+    assert pol.updates == 2
+    np.testing.assert_array_equal(learner.q, ref.q)
+    assert pol.reward_turns == 3 and pol.reward_sum == pytest.approx(256 / 3)
+    assert pol.reward_max == pytest.approx(256 / 3)
+    pol.end_episode("me", 0, (TurnEnergy(4, 90.0, "e", 84.0, 70.0),))  # nothing open any more
+    assert pol.updates == 2 and pol.reward_turns == 3
+    # a new round starts a new chain: its first record earns nothing
+    pol(_obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "e", 100.0, 60.0),), round_=1))
+    assert pol.reward_turns == 3
+    pol.end_all()  # a step without any turn yet: nothing to learn
     assert pol.updates == 2
     with pytest.raises(ValueError, match="step_turns"):
         LearnerPolicy(learner, np.random.default_rng(0), step_turns=0)
+
+
+def test_observation_without_history_is_refused() -> None:
+    pol = LearnerPolicy(TabularQ(), np.random.default_rng(0), step_turns=2)
+    pol(_obs(1, 100.0, 100.0, ()))
+    with pytest.raises(ValueError, match="history=True"):
+        pol(_obs(3, 100.0, 100.0, ()))
 
 
 @pytest.mark.engine
@@ -44,9 +96,13 @@ def test_tabular_learner_trains_live_in_engine(install) -> None:
     learner = TabularQ()
     q0 = learner.q.copy()
     pol = LearnerPolicy(learner, np.random.default_rng(1), step_turns=4)
-    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=2), pol)
+    res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=2), pol, **pol.bridge_kwargs())
     assert res.ok, (res.failures, res.server_errors)
+    turns = sum(int(r["turns"]) for r in res.run.summary["round_scores"])
+    # one round trip per T = 4 turns, and a reward for every turn played after the first decision
+    assert res.decisions == pol.decisions <= turns / 4 + 2
+    assert pol.reward_turns >= 4 * (pol.decisions - 2) - sum(res.run.skipped_turns.values())
     assert pol.updates >= pol.decisions - 2 > 20  # every SMDP step but the last open ones is learned
     assert learner.step == pol.updates
     assert not np.array_equal(learner.q, q0)
-    assert any(r > 0 for r in pol.rewards)  # it hit the duck
+    assert pol.reward_max > 0  # it hit the duck

@@ -125,6 +125,9 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path,
     # not fatal, so only protocol errors are ruled out here
     assert summary["bridge_errors"] == [] and all("bridge-failed" in f for f in summary["bridge_failures"])
     assert summary["updates"] > 20 and summary["learner"]["updates"] == summary["updates"]
+    # one round trip per decision: every T = 4 turns (turns 1, 5, 9, ... of each round), not every turn
+    turns = sum(int(r["turns"]) for r in rows)
+    assert summary["decisions"] <= turns / 4 + rounds and summary["updates"] >= summary["decisions"] - rounds
     assert json.loads((out / "summary.json").read_text())["updates"] == summary["updates"]
     learner, info = load_model(out)
     assert info["engine"] == "robocode" and learner.step == summary["updates"]

@@ -46,17 +46,27 @@ K_NONE, K_DUCK, K_SPIN, K_WALLS, K_TRACKER, K_RAMFIRE, K_FIRE, K_CORNERS, K_CRAZ
 O_MOVE, O_TURN, O_GUN, O_RADAR, O_FIRE, O_SCAN, O_STOP, O_RESUME, O_SETMAXV, O_SETMOVE, O_SETTURN, \
     O_WAITTURN, O_FIREASSIST = range(1, 14)
 Q = 8  # operations per queue
-# memory layout
-M_HPRIO, M_HLEN, M_HPOS, M_HSTART, M_MLEN, M_MPOS, M_MSTART, M_PHASE = range(8)
-M_VAR = 8  # 8 bot variables
-M_SAVE = 16  # stop(): saved distance, body, gun, radar remaining
-M_TARGET = 20  # scanned target of the running handler (fire assist)
-M_FRESH = 21  # 1 while the handler started in this decision (fire assist needs the scan's own turn)
-M_STOPPED = 22  # movement saved by stop() and not yet resumed
-M_HOPS = 24
-M_MOPS = M_HOPS + 2 * Q
-M_STATIC = M_MOPS + 2 * Q  # kept across rounds (Corners' corner)
+# memory layout (per robot)
+M_VAR = 0  # 8 bot variables
+M_SAVE = 8  # stop(): saved distance, body, gun, radar remaining
+M_STOPPED = 12  # movement saved by stop() and not yet resumed
+M_PHASE = 13  # run()'s set-up part done
+M_CLOCK = 14  # decisions made this round = time of the turn whose events are being delivered
+M_NEV = 15  # queued events
+M_TOPT, M_TOPSCAN, M_TOPB = 16, 17, 18  # the current top event (time, is a scan, bearing) for fire assist
+# execution levels: 0 = run(), 1..4 = handlers of priority 10, 20, 30, 40 (a handler nests only higher ones)
+LV_ACTIVE, LV_LEN, LV_POS, LV_START, LV_OPS = 0, 1, 2, 3, 4
+LV_SIZE = LV_OPS + 2 * Q
+N_LEVELS = 5
+M_LV = 20
+# event queue: time, priority, robot, bearing, distance, energy, aux (fault / bullet heading), sequence
+E_TIME, E_PRIO, E_J, E_BEAR, E_DIST, E_EN, E_AUX, E_SEQ = range(8)
+E_SIZE = 8
+N_EVQ = 24
+M_EVQ = M_LV + N_LEVELS * LV_SIZE
+M_STATIC = M_EVQ + N_EVQ * E_SIZE  # kept across rounds (Corners' corner)
 M_SIZE = M_STATIC + 2
+MAX_EVENT_STACK = 2  # Robocode EventManager: events older than 2 turns are dropped
 
 # play(): battle chunks per worker thread (a thread on a free core takes more when the other core is busy)
 _CHUNKS_PER_THREAD = 4
@@ -74,40 +84,49 @@ def bot_kind(name: str | None) -> int:
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _push(mem, b, i, base, lenpos, op, val):
-    """Append an operation to a queue (base = M_HOPS or M_MOPS, lenpos = M_HLEN or M_MLEN)."""
-    n = int(mem[b, i, lenpos])
-    if n < Q:
-        mem[b, i, base + 2 * n] = op
-        mem[b, i, base + 2 * n + 1] = val
-        mem[b, i, lenpos] = n + 1
+def _top_level(mem, b, i):
+    """The running execution level: the highest active handler, else run() (0)."""
+    for lv in range(N_LEVELS - 1, 0, -1):
+        if mem[b, i, M_LV + lv * LV_SIZE + LV_ACTIVE] == 1.0:
+            return lv
+    return 0
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _start_handler(mem, b, i, prio):
-    mem[b, i, M_FRESH] = 1.0
-    mem[b, i, M_HPRIO] = prio
-    mem[b, i, M_HLEN] = 0
-    mem[b, i, M_HPOS] = 0
-    mem[b, i, M_HSTART] = 0
+def _push(mem, b, i, lv, op, val):
+    """Append an operation to level lv's queue."""
+    base = M_LV + lv * LV_SIZE
+    n = int(mem[b, i, base + LV_LEN])
+    if n < Q:
+        mem[b, i, base + LV_OPS + 2 * n] = op
+        mem[b, i, base + LV_OPS + 2 * n + 1] = val
+        mem[b, i, base + LV_LEN] = n + 1
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _clear_level(mem, b, i, lv, active):
+    base = M_LV + lv * LV_SIZE
+    mem[b, i, base + LV_ACTIVE] = active
+    mem[b, i, base + LV_LEN] = 0
+    mem[b, i, base + LV_POS] = 0
+    mem[b, i, base + LV_START] = 0
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _h(mem, b, i, op, val):
-    _push(mem, b, i, M_HOPS, M_HLEN, op, val)
+    """Append an operation to the handler being dispatched (the top level)."""
+    _push(mem, b, i, _top_level(mem, b, i), op, val)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _m(mem, b, i, op, val):
-    _push(mem, b, i, M_MOPS, M_MLEN, op, val)
+    _push(mem, b, i, 0, op, val)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _refill_main(kind, mem, b, i, heading, width, height, others):
     """Next pass of run(): the set-up part once per round, then the loop body."""
-    mem[b, i, M_MLEN] = 0
-    mem[b, i, M_MPOS] = 0
-    mem[b, i, M_MSTART] = 0
+    _clear_level(mem, b, i, 0, 1.0)
     first = mem[b, i, M_PHASE] == 0
     mem[b, i, M_PHASE] = 1
     if kind == K_SPIN:
@@ -228,7 +247,7 @@ def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, rem, gun_eq_radar):
+def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, heading, rem, gun_eq_radar):
     """Write an operation's commands; True if it takes the turn (blocking)."""
     if op == O_MOVE:
         cmd[b, i, 0] = val
@@ -244,10 +263,11 @@ def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, 
         return True
     if op == O_FIRE or op == O_FIREASSIST:
         cmd[b, i, 4] = val
-        # fire assist (BasicRobotProxy.setFireImpl): fire() in onScannedRobot in the scan's own turn, gun
-        # and radar pointing the same way
-        if op == O_FIREASSIST and mem[b, i, M_FRESH] == 1.0 and gun_eq_radar:
-            assist[b, i] = normal_absolute_angle(math.atan2(tx - x, ty - y))
+        # fire assist (BasicRobotProxy.setFireImpl): a plain Robot whose top event is a scan of this very
+        # turn, gun and radar pointing the same way, fires at heading + the event's bearing
+        if kind != K_SPIN and kind != K_CRAZY and mem[b, i, M_TOPSCAN] == 1.0 and gun_eq_radar \
+                and mem[b, i, M_TOPT] == mem[b, i, M_CLOCK]:
+            assist[b, i] = normal_absolute_angle(heading + mem[b, i, M_TOPB])
         return True
     if op == O_SCAN:
         scan_req[b, i] = True
@@ -284,112 +304,165 @@ def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x, y, 
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing,
-            ev_fault, ev_hitby, ev_hitby_bearing, cmd):
-    """Start the event handler of the highest-priority event of the last turn (if it may run)."""
+def _add_event(mem, b, i, prio, j, bearing, dist, energy, aux):
+    """Queue an event of this turn (EventManager.add; a full queue drops it)."""
+    n = int(mem[b, i, M_NEV])
+    if n >= N_EVQ:
+        return
+    e = M_EVQ + n * E_SIZE
+    mem[b, i, e + E_TIME] = mem[b, i, M_CLOCK]
+    mem[b, i, e + E_PRIO] = prio
+    mem[b, i, e + E_J] = j
+    mem[b, i, e + E_BEAR] = bearing
+    mem[b, i, e + E_DIST] = dist
+    mem[b, i, e + E_EN] = energy
+    mem[b, i, e + E_AUX] = aux
+    mem[b, i, e + E_SEQ] = n + mem[b, i, M_CLOCK] * N_EVQ
+    mem[b, i, M_NEV] = n + 1
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _remove_event(mem, b, i, k):
+    n = int(mem[b, i, M_NEV])
+    for m in range(k, n - 1):
+        for f in range(E_SIZE):
+            mem[b, i, M_EVQ + m * E_SIZE + f] = mem[b, i, M_EVQ + (m + 1) * E_SIZE + f]
+    mem[b, i, M_NEV] = n - 1
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _before(mem, b, i, k, m):
+    """Event k sorts before event m (Event.compareTo: older first, then higher priority, then nearer scan /
+    own-fault ram; equal ones keep their order)."""
+    ek = M_EVQ + k * E_SIZE
+    em = M_EVQ + m * E_SIZE
+    if mem[b, i, ek + E_TIME] != mem[b, i, em + E_TIME]:
+        return mem[b, i, ek + E_TIME] < mem[b, i, em + E_TIME]
+    if mem[b, i, ek + E_PRIO] != mem[b, i, em + E_PRIO]:
+        return mem[b, i, ek + E_PRIO] > mem[b, i, em + E_PRIO]
+    if mem[b, i, ek + E_PRIO] == P_SCAN:
+        dd = int(mem[b, i, ek + E_DIST] - mem[b, i, em + E_DIST])  # ScannedRobotEvent: (int) distance difference
+        if dd != 0:
+            return dd < 0
+    elif mem[b, i, ek + E_PRIO] == P_ROBOT and mem[b, i, ek + E_AUX] != mem[b, i, em + E_AUX]:
+        return mem[b, i, ek + E_AUX] > mem[b, i, em + E_AUX]
+    return mem[b, i, ek + E_SEQ] < mem[b, i, em + E_SEQ]
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _enqueue(mem, b, i, x, y, h, energy, alive, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
+             ev_hitby_bearing):
+    """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns."""
     n = x.shape[1]
-    prio = mem[b, i, M_HPRIO]
-    in_scan_at_scan = prio == P_SCAN and int(mem[b, i, M_HPOS]) < int(mem[b, i, M_HLEN]) and \
-        mem[b, i, M_HOPS + 2 * int(mem[b, i, M_HPOS])] == O_SCAN and mem[b, i, M_HSTART] == 1
-    # hit robot (40)
     j = ev_robot[b, i]
-    if j >= 0 and prio < P_ROBOT:
-        bearing = ev_robot_bearing[b, i]
+    if j >= 0:
+        _add_event(mem, b, i, P_ROBOT, j, ev_robot_bearing[b, i], 0.0, energy[b, j], 1.0 if ev_fault[b, i] else 0.0)
+    if ev_wall[b, i]:
+        _add_event(mem, b, i, P_WALL, -1, 0.0, 0.0, 0.0, 0.0)
+    if ev_hitby[b, i] > 0:
+        # the bullet's heading: back along the bearing it came from
+        _add_event(mem, b, i, P_BULLET, -1, ev_hitby_bearing[b, i], 0.0, 0.0,
+                   ev_hitby_bearing[b, i] + h[b, i] - math.pi)
+    for j2 in range(n):
+        if scanned[b, i, j2] and alive[b, j2]:
+            dx = x[b, j2] - x[b, i]
+            dy = y[b, j2] - y[b, i]
+            bearing = normal_relative_angle(math.atan2(dx, dy) - h[b, i])
+            _add_event(mem, b, i, P_SCAN, j2, bearing, math.hypot(dx, dy), energy[b, j2], 0.0)
+    old = mem[b, i, M_CLOCK] - MAX_EVENT_STACK
+    k = 0
+    while k < int(mem[b, i, M_NEV]):
+        if mem[b, i, M_EVQ + k * E_SIZE + E_TIME] <= old:
+            _remove_event(mem, b, i, k)
+        else:
+            k += 1
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _head(mem, b, i):
+    """Index of the first queued event in Robocode's order (-1: empty)."""
+    best = -1
+    for k in range(int(mem[b, i, M_NEV])):
+        if best < 0 or _before(mem, b, i, k, best):
+            best = k
+    return best
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
+    """Start the handler of queued event k (removed from the queue): its level and operations."""
+    e = M_EVQ + k * E_SIZE
+    prio = mem[b, i, e + E_PRIO]
+    j = int(mem[b, i, e + E_J])
+    bearing = mem[b, i, e + E_BEAR]
+    dist = mem[b, i, e + E_DIST]
+    e_energy = mem[b, i, e + E_EN]
+    aux = mem[b, i, e + E_AUX]
+    mem[b, i, M_TOPT] = mem[b, i, e + E_TIME]
+    mem[b, i, M_TOPSCAN] = 1.0 if prio == P_SCAN else 0.0
+    mem[b, i, M_TOPB] = bearing
+    _remove_event(mem, b, i, k)
+    _clear_level(mem, b, i, int(prio // 10), 1.0)
+    hb = h[b, i]
+    if prio == P_ROBOT:
+        fault = aux == 1.0
         if kind == K_SPIN:
-            _start_handler(mem, b, i, P_ROBOT)
             if -10 * DEG < bearing < 10 * DEG:
                 _h(mem, b, i, O_FIRE, 3.0)
-            if ev_fault[b, i]:
+            if fault:
                 _h(mem, b, i, O_TURN, 10 * DEG)
-            return
-        if kind == K_WALLS:
-            _start_handler(mem, b, i, P_ROBOT)
+        elif kind == K_WALLS:
             _h(mem, b, i, O_MOVE, -100.0 if -math.pi / 2 < bearing < math.pi / 2 else 100.0)
-            return
-        if kind == K_TRACKER:
+        elif kind == K_TRACKER:
             mem[b, i, M_VAR + 2] = j
-            _start_handler(mem, b, i, P_ROBOT)
-            amt = normal_relative_angle(bearing + h[b, i] - rh[b, i])
+            amt = normal_relative_angle(bearing + hb - rh[b, i])
             mem[b, i, M_VAR + 1] = amt / DEG
             _h(mem, b, i, O_GUN, amt)
             _h(mem, b, i, O_FIRE, 3.0)
             _h(mem, b, i, O_MOVE, -50.0)
-            return
-        if kind == K_RAMFIRE:
+        elif kind == K_RAMFIRE:
             mem[b, i, M_VAR] = 1.0 if bearing >= 0 else -1.0
-            _start_handler(mem, b, i, P_ROBOT)
             _h(mem, b, i, O_TURN, bearing)
-            e = energy[b, j]
-            if e > 16:
+            if e_energy > 16:
                 _h(mem, b, i, O_FIRE, 3.0)
-            elif e > 10:
+            elif e_energy > 10:
                 _h(mem, b, i, O_FIRE, 2.0)
-            elif e > 4:
+            elif e_energy > 4:
                 _h(mem, b, i, O_FIRE, 1.0)
-            elif e > 2:
+            elif e_energy > 2:
                 _h(mem, b, i, O_FIRE, 0.5)
-            elif e > 0.4:
+            elif e_energy > 0.4:
                 _h(mem, b, i, O_FIRE, 0.1)
             _h(mem, b, i, O_MOVE, 40.0)
-            return
-        if kind == K_FIRE:
-            _start_handler(mem, b, i, P_ROBOT)
-            _h(mem, b, i, O_GUN, normal_relative_angle(bearing + h[b, i] - gh[b, i]))
+        elif kind == K_FIRE:
+            _h(mem, b, i, O_GUN, normal_relative_angle(bearing + hb - gh[b, i]))
             _h(mem, b, i, O_FIRE, 3.0)
-            return
+        elif kind == K_CRAZY and fault:
+            _reverse(mem, b, i, cmd)
+    elif prio == P_WALL:
         if kind == K_CRAZY:
-            if ev_fault[b, i]:
-                _reverse(mem, b, i, cmd)
-    # hit wall (30): Crazy reverses (no blocking call)
-    if ev_wall[b, i] and kind == K_CRAZY and prio < P_WALL:
-        _reverse(mem, b, i, cmd)
-    # hit by bullet (20): Fire turns perpendicular and moves
-    if ev_hitby[b, i] > 0 and kind == K_FIRE and prio < P_BULLET:
-        bullet_heading = ev_hitby_bearing[b, i] + h[b, i] - math.pi
-        _start_handler(mem, b, i, P_BULLET)
-        _h(mem, b, i, O_TURN, normal_relative_angle(math.pi / 2 - (h[b, i] - bullet_heading)))
-        _h(mem, b, i, O_MOVE, mem[b, i, M_VAR])
-        mem[b, i, M_VAR] *= -1
-        _h(mem, b, i, O_SCAN, 0.0)
-        return
-    # scanned robot (10)
-    if prio < P_SCAN or in_scan_at_scan:
-        best = -1
-        bd = 1e18
-        track = int(mem[b, i, M_VAR + 2]) if kind == K_TRACKER else -1
-        for j2 in range(n):
-            if scanned[b, i, j2] and alive[b, j2]:
-                d = math.hypot(x[b, j2] - x[b, i], y[b, j2] - y[b, i])
-                if track >= 0 and j2 == track:
-                    best = j2
-                    break
-                if d < bd:
-                    bd = d
-                    best = j2
-        if best < 0:
-            return
-        if kind == K_TRACKER and track >= 0 and best != track:
-            return
-        j = best
-        dx = x[b, j] - x[b, i]
-        dy = y[b, j] - y[b, i]
-        dist = math.hypot(dx, dy)
-        bearing = normal_relative_angle(math.atan2(dx, dy) - h[b, i])
-        mem[b, i, M_TARGET] = j
+            _reverse(mem, b, i, cmd)
+    elif prio == P_BULLET:
+        if kind == K_FIRE:  # turn perpendicular to the bullet, move, scan
+            _h(mem, b, i, O_TURN, normal_relative_angle(math.pi / 2 - (hb - aux)))
+            _h(mem, b, i, O_MOVE, mem[b, i, M_VAR])
+            mem[b, i, M_VAR] *= -1
+            _h(mem, b, i, O_SCAN, 0.0)
+    else:  # scanned robot
         if kind == K_SPIN or kind == K_CRAZY:
-            _start_handler(mem, b, i, P_SCAN)
             _h(mem, b, i, O_FIRE, 3.0 if kind == K_SPIN else 1.0)
         elif kind == K_WALLS:
-            _start_handler(mem, b, i, P_SCAN)
             _h(mem, b, i, O_FIREASSIST, 2.0)
             if mem[b, i, M_VAR] == 1.0:
                 _h(mem, b, i, O_SCAN, 0.0)
         elif kind == K_TRACKER:
+            track = int(mem[b, i, M_VAR + 2])
+            if track >= 0 and j != track:
+                return
             mem[b, i, M_VAR + 2] = j
             mem[b, i, M_VAR] = 0.0
-            amt = normal_relative_angle(bearing + h[b, i] - rh[b, i])
+            amt = normal_relative_angle(bearing + hb - rh[b, i])
             mem[b, i, M_VAR + 1] = amt / DEG
-            _start_handler(mem, b, i, P_SCAN)
             _h(mem, b, i, O_GUN, amt)
             if dist > 150:
                 _h(mem, b, i, O_TURN, bearing)
@@ -401,17 +474,14 @@ def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_w
                 _h(mem, b, i, O_SCAN, 0.0)
         elif kind == K_RAMFIRE:
             mem[b, i, M_VAR] = 1.0 if bearing >= 0 else -1.0
-            _start_handler(mem, b, i, P_SCAN)
             _h(mem, b, i, O_TURN, bearing)
             _h(mem, b, i, O_MOVE, dist + 5)
             _h(mem, b, i, O_SCAN, 0.0)
         elif kind == K_FIRE:
-            _start_handler(mem, b, i, P_SCAN)
             _h(mem, b, i, O_FIREASSIST, 3.0 if dist < 50 and energy[b, i] > 50 else 1.0)
             _h(mem, b, i, O_SCAN, 0.0)
         elif kind == K_CORNERS:
             p = 1.0 if (dist > 200 or energy[b, i] < 15) else (2.0 if dist > 50 else 3.0)
-            _start_handler(mem, b, i, P_SCAN)
             if mem[b, i, M_VAR] == 1.0:
                 _h(mem, b, i, O_STOP, 0.0)
                 _h(mem, b, i, O_FIREASSIST, p)
@@ -421,35 +491,17 @@ def _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_w
                 _h(mem, b, i, O_FIREASSIST, p)
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _finish_handler(mem, b, i, rem):
-    """A handler whose last operation just finished returns before this turn's events are dispatched.
-
-    Events that could not interrupt it (same or lower priority) are then handled at once, as
-    Robocode's EventManager does when the handler returns. A handler waiting in scan() is left to
-    _events, which restarts it when a robot is seen (Robocode's rescan).
-    """
-    if mem[b, i, M_HPRIO] == 0 or mem[b, i, M_HSTART] != 1:
-        return
-    pos = int(mem[b, i, M_HPOS])
-    n = int(mem[b, i, M_HLEN])
-    if pos >= n or pos != n - 1:
-        return
-    op = mem[b, i, M_HOPS + 2 * pos]
-    if op == O_SCAN:
-        return
-    if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
-        mem[b, i, M_HLEN] = 0
-        mem[b, i, M_HPOS] = 0
-        mem[b, i, M_HPRIO] = 0
-        mem[b, i, M_HSTART] = 0
-
-
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
                  ev_hitby_bearing, ev_died, width, height, cmd, rem):
-    """One decision of battle b's scripted robots (their robot time between two turns)."""
+    """One decision of battle b's scripted robots (their robot time between two turns).
+
+    Each robot resumes inside the execute() of its running blocking call: EventManager.processEvents first
+    (dispatch the head event while its priority is above the running level's; an equal one stops the loop
+    unless the running handler waits in scan(), which it then aborts), then the call's remaining-value test,
+    then the code after it up to the next blocking call.
+    """
     n = x.shape[1]
     others = 0
     for i in range(n):
@@ -462,49 +514,65 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
             if start > 0 and (start - others) / start < 0.75:
                 c = mem[b, i, M_STATIC] + 90
                 mem[b, i, M_STATIC] = -90.0 if c == 270 else c
-        if kind == K_NONE or kind == K_DUCK or not alive[b, i]:
-            continue
-        if energy[b, i] == 0.0:
+        if kind == K_NONE or kind == K_DUCK or not alive[b, i] or energy[b, i] == 0.0:
+            mem[b, i, M_CLOCK] += 1
             continue
         rem[0] = dist_rem[b, i]
         rem[1] = body_rem[b, i]
         rem[2] = gun_rem[b, i]
         rem[3] = radar_rem[b, i]
-        _finish_handler(mem, b, i, rem)
-        _events(kind, mem, b, i, x, y, h, gh, rh, energy, alive, team, scanned, ev_wall, ev_robot,
-                ev_robot_bearing, ev_fault, ev_hitby, ev_hitby_bearing, cmd)
-        t = int(mem[b, i, M_TARGET])
-        tx = x[b, t] if t >= 0 else 0.0
-        ty = y[b, t] if t >= 0 else 0.0
-        for _ in range(24):
-            in_handler = mem[b, i, M_HPRIO] > 0  # a handler with no operations ends at once
-            if in_handler:
-                base, lenp, posp, startp = M_HOPS, M_HLEN, M_HPOS, M_HSTART
-            else:
-                base, lenp, posp, startp = M_MOPS, M_MLEN, M_MPOS, M_MSTART
-            pos = int(mem[b, i, posp])
-            if pos >= int(mem[b, i, lenp]):
-                if in_handler:
-                    mem[b, i, M_HLEN] = 0
-                    mem[b, i, M_HPOS] = 0
-                    mem[b, i, M_HPRIO] = 0
-                    mem[b, i, M_HSTART] = 0
-                else:
-                    _refill_main(kind, mem, b, i, h[b, i], width, height, others - 1)
-                continue
-            op = mem[b, i, base + 2 * pos]
-            val = mem[b, i, base + 2 * pos + 1]
-            if mem[b, i, startp] == 1:
-                if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
-                    mem[b, i, posp] = pos + 1
-                    mem[b, i, startp] = 0
+        _enqueue(mem, b, i, x, y, h, energy, alive, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
+                 ev_hitby_bearing)
+        lv = _top_level(mem, b, i)
+        process = True
+        for _ in range(48):
+            base = M_LV + lv * LV_SIZE
+            if process:
+                k = _head(mem, b, i)
+                if k < 0:
+                    process = False
                     continue
-                break  # still running: nothing new this turn
-            mem[b, i, startp] = 1
-            if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, tx, ty, x[b, i], y[b, i], rem,
-                      gh[b, i] == rh[b, i]):
+                prio = mem[b, i, M_EVQ + k * E_SIZE + E_PRIO]
+                cur = 10.0 * lv if lv > 0 else -1.0
+                if prio < cur:
+                    process = False
+                elif prio == cur:
+                    pos = int(mem[b, i, base + LV_POS])
+                    if lv == 1 and mem[b, i, base + LV_START] == 1 and pos < int(mem[b, i, base + LV_LEN]) \
+                            and mem[b, i, base + LV_OPS + 2 * pos] == O_SCAN:
+                        # the handler waits in scan() (interruptible): EventInterruptedException ends it
+                        _clear_level(mem, b, i, lv, 0.0)
+                        mem[b, i, M_TOPT] = -1.0
+                        mem[b, i, M_TOPSCAN] = 0.0
+                        lv = _top_level(mem, b, i)
+                    else:
+                        process = False
+                else:
+                    _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd)
+                    lv = int(prio // 10)
+                    process = False
+                continue
+            pos = int(mem[b, i, base + LV_POS])
+            if pos >= int(mem[b, i, base + LV_LEN]):
+                if lv == 0:
+                    _refill_main(kind, mem, b, i, h[b, i], width, height, others - 1)
+                else:  # the handler returns into the processEvents loop of the level below
+                    _clear_level(mem, b, i, lv, 0.0)
+                    lv = _top_level(mem, b, i)
+                    process = True
+                continue
+            op = mem[b, i, base + LV_OPS + 2 * pos]
+            val = mem[b, i, base + LV_OPS + 2 * pos + 1]
+            if mem[b, i, base + LV_START] == 1:
+                if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
+                    mem[b, i, base + LV_POS] = pos + 1
+                    mem[b, i, base + LV_START] = 0
+                    continue
+                break  # still running: execute() again
+            mem[b, i, base + LV_START] = 1
+            if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, h[b, i], rem, gh[b, i] == rh[b, i]):
                 break
-        mem[b, i, M_FRESH] = 0.0
+        mem[b, i, M_CLOCK] += 1
 
 
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
@@ -524,7 +592,7 @@ def _clear_memory(mem, b):
     for i in range(mem.shape[1]):
         for k in range(M_STATIC):
             mem[b, i, k] = 0.0
-        mem[b, i, M_TARGET] = -1.0
+        mem[b, i, M_TOPT] = -1.0
 
 
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
@@ -601,7 +669,7 @@ class ScriptedBots:
         keep = self.mem[idx, :, M_STATIC:].copy()
         self.mem[idx] = 0.0
         self.mem[idx, :, M_STATIC:] = keep
-        self.mem[idx, :, M_TARGET] = -1.0
+        self.mem[idx, :, M_TOPT] = -1.0
         self._round[idx] = self.arena.state.round[idx]
 
     def sync_rounds(self) -> None:

@@ -4,20 +4,20 @@ SittingDuck, SpinBot, Walls, Tracker, RamFire, Fire, Corners and Crazy, written 
 behaviour (main loop of blocking calls, event handlers). A plain ``Robot`` blocks on every call; here
 each robot has a small state machine in a per-robot memory row:
 
-- a *main* queue of operations (the current pass of ``run()``'s loop) and a *handler* queue (the
-  event handler running, with its priority); a handler interrupts the main queue, which then
-  resumes its current operation - finished if the handler's own moves used up the remaining value,
-  exactly as a blocking call in ``run()`` re-checks ``getDistanceRemaining()`` after a handler.
+- execution levels: ``run()``'s loop (level 0) and one level per handler priority (scanned robot 10, hit
+  by bullet 20, hit wall 30, hit robot 40), each a queue of operations; a handler nests only handlers of
+  higher priority, and when it returns the level below resumes its blocking call (finished if the
+  remaining value is 0 by then: Robocode's ``do { execute() } while (remaining != 0)``).
 - operations: blocking move / body / gun / radar turns (done when the remaining value is 0, after
   at least one turn), ``fire`` / ``scan`` / ``stop`` / ``resume`` (one turn each), setters that do
   not block (``setAhead``, ``setTurnRight``, ``setMaxVelocity``) and ``waitFor(turn complete)``.
-- events (Robocode priorities): scanned robot 10, hit by bullet 20, hit wall 30, hit robot 40. A
-  handler starts when nothing of equal or higher priority runs; ``scan()`` at the end of an
-  ``onScannedRobot`` restarts it when a robot is seen again (Robocode's interrupted handler).
-  Scanned data are the true end-of-turn values of the scanned robot (what the event carries).
-  With several robots scanned in one turn the nearest is taken (Tracker: its tracked robot).
-- a plain Robot's ``fire`` inside ``onScannedRobot`` uses Robocode's fire assist (the bullet heads
-  at the scanned robot when the gun and radar turned together).
+- events: Robocode's EventManager. Each turn's events are queued with a copy of their data (bearing,
+  distance, energy as of that turn); older than 2 turns they are dropped. Between two turns a robot first
+  runs processEvents: the head event (oldest first, then higher priority, nearer scan, own-fault ram) is
+  dispatched while its priority is above the running level's; an equal one stops the loop, unless the
+  running handler waits in ``scan()``, which it then aborts (EventInterruptedException).
+- a plain Robot's ``fire`` uses Robocode's fire assist when its top event is a scan of the same turn and
+  gun and radar point the same way: the bullet heads at heading + the event's bearing.
 
 Usage: ``bots = ScriptedBots(arena, ["SpinBot", None, ...])`` (a name per robot, None = driven by
 someone else), then every turn ``bots.commands(cmd)`` fills those robots' rows of ``cmd``. A new

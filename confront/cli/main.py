@@ -145,13 +145,18 @@ def sweep(grid: Path, out: Path, address: str | None, seeds: int | None) -> None
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
 @click.option("--rounds", type=int, default=10, show_default=True)
 @click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--battles", type=int, default=1, show_default=True,
+              help="Simulator: split the rounds over this many parallel battles (faster; battle b has seed+b).")
 @click.option("--replay", "replay_out", type=click.Path(path_type=Path), default=None,
-              help="Also record the first round to this replay file (.json; simulator only).")
-def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: int, replay_out: Path | None) -> None:
+              help="Also record the first round to this replay file (.json or .json.gz, plus .gif and .html; "
+                   "simulator only).")
+def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: int, battles: int,
+           replay_out: Path | None) -> None:
     """Run a battle of scripted robots in the simulator or the real engine and print Robocode's score table."""
     from confront.experiments.evaluate import battle_cli
 
-    battle_cli(scenario=scenario, robots=robots, engine=engine, rounds=rounds, seed=seed, replay_out=replay_out)
+    battle_cli(scenario=scenario, robots=robots, engine=engine, rounds=rounds, seed=seed, replay_out=replay_out,
+               battles=battles)
 
 
 @cli.command()

@@ -301,7 +301,7 @@ def _evaluate(cfg: BaselinesConfig, exp: Any, seed: int, td_path: Path, policy: 
             td, _ = load_model(td_path)
             o, t, r = _pooled_ratio(sim_evaluate(exp, td, scripted, cfg.eval_rounds, eval_seed), flip=True)
         else:
-            res = sim_bot_battle(exp.arena.scenario, [scripted, opp], cfg.eval_rounds, eval_seed)
+            res = sim_bot_battle(exp.arena.scenario, [scripted, opp], cfg.eval_rounds, eval_seed, n_battles=16)
             o = sum(c.total for c in res.contestants if c.name.endswith("team 0"))
             t = sum(c.total for c in res.contestants if not c.name.endswith("team 0"))
             r = o / (o + t) if o + t > 0 else 0.5

@@ -134,8 +134,13 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     click.echo("\n" + "\n".join(lines) + f"\n(simulator seeds {', '.join(map(str, seeds))}: no battle in common)")
 
 
-def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int) -> BattleResults:
-    """Scripted robots in the simulator: one name per team (a team is filled with copies of its robot)."""
+def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int, n_battles: int = 1) -> BattleResults:
+    """Scripted robots in the simulator: one name per team (a team is filled with copies of its robot).
+
+    ``n_battles = 1`` plays one battle of ``rounds`` rounds as Robocode does (robots such as Corners remember
+    across rounds; with the engine's seed the start positions and processing order are the engine's); more
+    battles split the rounds for speed (battle b is seeded ``seed + b``).
+    """
     from confront.arena.bots import bot_battle
     from confront.arena.scoring import results_table
 
@@ -144,14 +149,43 @@ def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int) -> 
         raise click.UsageError(f"scenario {sc.name} has {len(sc.teams)} teams: give {len(sc.teams)} robots, "
                                f"got {','.join(robots)}")
     team = np.asarray(sc.team_ids())
-    parts, places = bot_battle([robots[t] for t in team], rounds, seed=seed, n_battles=16, scenario=sc)
-    labels = [name if size == 1 else f"{name} team {k}"
-              for k, (name, size) in enumerate(zip(robots, sc.teams, strict=True))]
-    return results_table(parts, places, team, labels, rounds=rounds)
+    parts, places = bot_battle([robots[t] for t in team], rounds, seed=seed, n_battles=n_battles, scenario=sc)
+    return results_table(parts, places, team, _labels(robots, sc.teams), rounds=rounds)
+
+
+def _labels(robots: list[str], sizes: tuple[int, ...]) -> list[str]:
+    return [name if size == 1 else f"{name} team {k}" for k, (name, size) in enumerate(zip(robots, sizes, strict=True))]
+
+
+def record_bot_round(scenario: str, robots: list[str], seed: int, out: Path) -> Path:
+    """The first round of a scripted battle (the same battle as ``sim_bot_battle`` with one battle) as a replay
+    file ``out`` (.json or .json.gz) with a GIF and an HTML player beside it."""
+    from confront.arena import replay as rp
+    from confront.arena.bots import ScriptedBots
+    from confront.arena.core import Arena
+
+    sc = scenario_of(scenario)
+    team = sc.team_ids()
+    arena = Arena(sc.replace(max_turns=100000), 1, seed=seed)
+    names = [robots[t] for t in team]
+    bots = ScriptedBots(arena, names)
+    replay = rp.new_replay(arena, [f"{n} ({i})" for i, n in enumerate(names)])
+    cmd = arena.idle_commands()
+    rp.record_frame(replay, arena)
+    while not arena.state.done[0]:
+        bots.commands(cmd)
+        arena.step(cmd)
+        rp.record_frame(replay, arena)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    path = replay.save(out)
+    stem = out.name.removesuffix(".gz").removesuffix(".json").removesuffix(".replay")
+    rp.write_gif(replay, out.with_name(stem + ".gif"))
+    rp.write_html(replay, out.with_name(stem + ".html"), title=f"confront: {' vs '.join(robots)}")
+    return Path(path)
 
 
 def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed: int,
-               replay_out: Path | None) -> None:
+               replay_out: Path | None, battles: int = 1) -> None:
     sc = scenario_of(scenario)
     from confront.arena.bots import BOT_NAMES
 
@@ -161,19 +195,25 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
     for n in names:
         if n not in BOT_NAMES:
             raise click.UsageError(f"unknown robot {n!r}: use {', '.join(BOT_NAMES)}")
+    if battles < 1:
+        raise click.UsageError(f"--battles must be >= 1, got {battles}")
     if engine == "robocode":
         from confront.engine.runner import run_scenario
 
+        if replay_out is not None:
+            raise click.UsageError("--replay records simulator battles only")
         if len(names) != 2:
             raise click.UsageError("--engine robocode battles take two sides: --robots OURS,THEIRS")
         run = run_scenario(sc.name, names[0], names[1], rounds=rounds, seed=seed)
         click.echo(f"Robocode, {sc.name}, {rounds} rounds ({run.turns} turns, {run.elapsed_s:.1f} s, "
                    f"{sum(run.skipped_turns.values())} skipped turns):\n{run.results.to_markdown()}")
         return
-    res = sim_bot_battle(sc.name if not scenario.endswith(".toml") else scenario, names, rounds, seed)
+    where = sc.name if not scenario.endswith(".toml") else scenario
+    res = sim_bot_battle(where, names, rounds, seed, n_battles=battles)
     click.echo(f"simulator, {sc.name}, {rounds} rounds:\n{res.to_markdown()}")
     if replay_out is not None:
-        click.echo("(replays of scripted battles: use `confront replay` on a training run's replays/)")
+        path = record_bot_round(where, names, seed, replay_out)
+        click.echo(f"replay of the first round: {path} (and .gif, .html beside it)")
 
 
 def export_cli(run: Path, out: Path, name: str | None) -> None:

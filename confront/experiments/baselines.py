@@ -315,6 +315,7 @@ def train_sb3(algo: str, cfg: BaselinesConfig, seed: int, rounds: int) -> tuple[
     import torch
     from stable_baselines3 import DQN, PPO
     from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.logger import Logger
 
     from confront.experiments.train import scenario_of, smdp_config, td_team
 
@@ -341,6 +342,8 @@ def train_sb3(algo: str, cfg: BaselinesConfig, seed: int, rounds: int) -> tuple[
     else:
         model = PPO("MlpPolicy", env, learning_rate=cfg.ppo_learning_rate, gamma=cfg.gamma, n_steps=cfg.ppo_n_steps,
                     batch_size=cfg.ppo_batch_size, n_epochs=cfg.ppo_n_epochs, seed=seed, device="cpu", verbose=0)
+    # SB3's default logger makes an empty folder in the system temp dir per model: log nowhere instead
+    model.set_logger(Logger(folder=None, output_formats=[]))
     start = time.time()
     model.learn(total_timesteps=budget, callback=StopAfterRounds())
     info = {"train_rounds": env.rounds_done, "train_seconds": time.time() - start, "td_model": str(td_path),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -138,7 +139,9 @@ def test_tiny_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Non
     monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path / "cache"))
     cfg = BaselinesConfig(overrides=("opponent.pretrain_rounds=4", "train.replay=false", "arena.battles=2"),
                           eval_rounds=2, scripted=("SpinBot", "Walls"))
+    sb3_dirs = set(Path(tempfile.gettempdir()).glob("SB3-*"))
     outcome = baselines_outcome(1, tmp_path / "out", 4, 1, cfg)
+    assert set(Path(tempfile.gettempdir()).glob("SB3-*")) == sb3_dirs  # SB3 leaves no log folders behind
     root = tmp_path / "out" / "baselines"
     with (root / "results.csv").open() as fh:
         rows = list(csv.DictReader(fh))

@@ -37,7 +37,8 @@ from confront.learning.tabular import TabularQ
 from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
-__all__ = ["train_run", "print_summary", "build_learner", "load_model", "save_model", "scenario_of", "td_team"]
+__all__ = ["train_run", "print_summary", "build_learner", "load_model", "save_model", "scenario_of", "td_team",
+           "new_run", "resume_run"]
 
 
 # -- building blocks ---------------------------------------------------------------------------------------------
@@ -339,24 +340,34 @@ def _setup(cfg: ExperimentConfig, progress: bool) -> tuple[Loop, dict[str, Any]]
     return Loop(env, side, seed=cfg.train.seed), info
 
 
+def resume_run(out: str | Path | None) -> tuple[Run, ExperimentConfig]:
+    """An existing run folder and the config it was started with (for ``--resume``)."""
+    if out is None:
+        raise ValueError("resume needs the run folder")
+    run = Run(Path(out))
+    if not (run.path / "config.toml").exists():
+        raise FileNotFoundError(f"{run.path} is not a run folder (no config.toml)")
+    return run, config_from_dict(load_toml(run.path / "config.toml"))
+
+
+def new_run(cfg: ExperimentConfig, out: str | Path | None, exist_ok: bool = False) -> Run:
+    """A new run folder ``out`` (default ``runs/<name>-<time>``) holding the resolved config."""
+    from confront.runs import new_run_name
+
+    return Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
+                      exist_ok=exist_ok)
+
+
 def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool = False, progress: bool = True,
               exist_ok: bool = False) -> dict[str, Any]:
     """Train one arm into a run folder (or continue it with ``resume``); return its summary."""
     start = time.time()
     if resume:
-        if out is None:
-            raise ValueError("resume needs the run folder")
-        run = Run(Path(out))
-        if not (run.path / "config.toml").exists():
-            raise FileNotFoundError(f"{run.path} is not a run folder (no config.toml)")
-        cfg = config_from_dict(load_toml(run.path / "config.toml"))
+        run, cfg = resume_run(out)
+    elif cfg is None:
+        raise ValueError("train_run needs a config unless resuming")
     else:
-        if cfg is None:
-            raise ValueError("train_run needs a config unless resuming")
-        from confront.runs import new_run_name
-
-        run = Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
-                         exist_ok=exist_ok)
+        run = new_run(cfg, out, exist_ok)
     loop, info = _setup(cfg, progress)
     elapsed_before = 0.0
     if resume:

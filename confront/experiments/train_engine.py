@@ -32,7 +32,6 @@ from confront import checkpoint as ck
 from confront.arena.observe import ObservationConfig
 from confront.arena.state import SCORE_PARTS
 from confront.checkpoint import CheckpointError
-from confront.config import load_toml, to_dict
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
 from confront.engine.bridge import Action, Observation, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
@@ -40,18 +39,20 @@ from confront.engine.evaluate import _single_star
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
-from confront.experiments.spec import ExperimentConfig, config_from_dict
+from confront.experiments.spec import ExperimentConfig
 from confront.experiments.train import (
     _plots,
     build_learner,
     load_model,
+    new_run,
+    resume_run,
     save_model,
     session_rows,
     td_team,
 )
 from confront.learning.base import Learner
 from confront.learning.transfer import TransferParams, TransferPolicy
-from confront.runs import Run, new_run_name
+from confront.runs import Run
 
 __all__ = ["train_in_engine", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
 
@@ -213,12 +214,7 @@ def train_in_engine(
     """
     start = time.time()
     if resume:
-        if out is None:
-            raise ValueError("resume needs the run folder")
-        run = Run(Path(out))
-        if not (run.path / "config.toml").exists():
-            raise FileNotFoundError(f"{run.path} is not a run folder (no config.toml)")
-        cfg = config_from_dict(load_toml(run.path / "config.toml"))
+        run, cfg = resume_run(out)
     elif cfg is None:
         raise ValueError("train_in_engine needs a config unless resuming")
     _check(cfg)
@@ -226,8 +222,7 @@ def train_in_engine(
     learner = build_learner(cfg, obs_cfg.n_features, N_MOVES)
     acting, transfer_info = _transfer(cfg, learner)
     if not resume:
-        run = Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
-                         exist_ok=exist_ok)
+        run = new_run(cfg, out, exist_ok)
     policy = LearnerPolicy(acting, np.random.default_rng([cfg.train.seed, 0]), train=True, explore=True,
                            observation=obs_cfg, step_turns=cfg.arena.decision_turns)
     state: dict[str, Any] = {"rounds_done": 0, "battles": 0, "rows": [], "skipped_turns": 0, "bridge_failures": [],

@@ -123,7 +123,7 @@ def test_score_shares_match_the_real_engine(pair):
     from confront.engine.battle import BattleSpec
     from confront.engine.runner import EngineOptions, run_battle
 
-    run = run_battle(BattleSpec(contestants=pair, rounds=20), EngineOptions(seed=1))
+    run = run_battle(BattleSpec(contestants=pair, rounds=20), EngineOptions(seed=1, cpu_constant_ms=100.0))  # no skips
     eng = {r.name.split(".")[-1]: r.total for r in run.results.contestants}
     eng_share = eng[pair[0]] / sum(eng.values())
     parts, _ = bot_battle(list(pair), rounds=20, seed=1, n_battles=1)

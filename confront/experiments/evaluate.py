@@ -150,11 +150,9 @@ def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int, n_b
                                f"got {','.join(robots)}")
     team = np.asarray(sc.team_ids())
     parts, places = bot_battle([robots[t] for t in team], rounds, seed=seed, n_battles=n_battles, scenario=sc)
-    return results_table(parts, places, team, _labels(robots, sc.teams), rounds=rounds)
-
-
-def _labels(robots: list[str], sizes: tuple[int, ...]) -> list[str]:
-    return [name if size == 1 else f"{name} team {k}" for k, (name, size) in enumerate(zip(robots, sizes, strict=True))]
+    labels = [name if size == 1 else f"{name} team {k}"
+              for k, (name, size) in enumerate(zip(robots, sc.teams, strict=True))]
+    return results_table(parts, places, team, labels, rounds=rounds)
 
 
 def record_bot_round(scenario: str, robots: list[str], seed: int, out: Path) -> Path:

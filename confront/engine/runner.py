@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,7 @@ class EngineOptions:
     max_heap_mb: int = 512
     timeout_s: float = 900.0
     extra_jvm_args: tuple[str, ...] = ()
+    round_start_fix: bool = True  # RoundStartAgent: no lost wake-up wait at round start (docs/engine.md)
 
     def __post_init__(self) -> None:
         if self.seed is not None and not -(2**63) <= self.seed < 2**63:
@@ -71,8 +73,23 @@ def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: Eng
     if opts.nosecurity:
         cmd.append("-DNOSECURITY=true")  # robots may open loopback sockets (bridge)
     cmd += list(opts.extra_jvm_args)
+    if opts.round_start_fix:
+        cmd.append(f"-javaagent:{agent_jar(classes)}")
     cmd += ["-cp", f"{install.classpath}{os.pathsep}{classes}", RUNNER_CLASS]
     return cmd
+
+
+def agent_jar(classes: Path) -> Path:
+    """The jar of ``RoundStartAgent`` (made once next to the compiled classes)."""
+    jar = classes / "roundstart-agent.jar"
+    if not jar.is_file():
+        tmp = classes / f"roundstart-agent.{os.getpid()}.tmp"
+        with zipfile.ZipFile(tmp, "w") as z:
+            z.writestr("META-INF/MANIFEST.MF", "Manifest-Version: 1.0\nPremain-Class: confront.RoundStartAgent\n")
+            for f in sorted((classes / "confront").glob("RoundStartAgent*.class")):
+                z.write(f, f"confront/{f.name}")
+        tmp.replace(jar)
+    return jar
 
 
 def _die_with_parent() -> None:  # pragma: no cover - runs in the child between fork and exec

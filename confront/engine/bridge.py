@@ -31,7 +31,9 @@ import contextlib
 import importlib
 import json
 import math
+import os
 import secrets
+import selectors
 import socket
 import sys
 import threading
@@ -44,7 +46,16 @@ from confront.arena.control import ControlConfig
 
 PROTOCOL_VERSION = 2
 LOOPBACK = "127.0.0.1"
-MAX_LINE = 1 << 20
+TOKEN_ENV = "CONFRONT_BRIDGE_TOKEN"  # how the robots get the token: the engine's environment, not its command line
+MAX_LINE = 1 << 20  # longest line of a robot that presented the token (bytes); longer: the connection is dropped
+MAX_HELLO = 1 << 14  # longest hello line (bytes), read before the token is known
+HELLO_TIMEOUT_S = 5.0  # a connection that has not sent a complete hello by then is dropped
+MAX_PENDING = 64  # connections waiting for their hello; a newer one beyond this drops the oldest
+MAX_ROBOTS = 256  # robot sessions (connections that presented the token) at once; more are refused
+MAX_ERRORS = 100  # error messages kept (the rest are only counted)
+MAX_NAMES = 1000  # characters of a hello's name and team fields
+BATTLEFIELD = (400.0, 5000.0)  # Robocode's battlefield width and height range [BattlefieldSpecification]
+_STAT_MAX = 1 << 53  # robot-reported counters above this are not believed
 
 
 @dataclass(frozen=True)
@@ -166,17 +177,26 @@ def _check_version(msg: dict[str, Any], kind: str) -> None:
 
 
 def parse_hello(line: str, token: str) -> dict[str, Any]:
-    """Validate a hello line; returns the message."""
+    """Validate a hello line; returns the message. The token is checked before anything else is trusted."""
     msg = json.loads(line)
     if not isinstance(msg, dict):
         raise ValueError("hello is not a JSON object")
-    _check_version(msg, "hello")
-    if not secrets.compare_digest(str(msg.get("token", "")), token):
+    if not isinstance(msg.get("token"), str) or not secrets.compare_digest(msg["token"].encode(), token.encode()):
         raise ValueError("hello with a wrong token")
-    if not isinstance(msg.get("name"), str) or not isinstance(msg.get("team"), str):
-        raise ValueError("hello without robot name/team")
+    _check_version(msg, "hello")
+    for key in ("name", "team"):
+        if not isinstance(msg.get(key), str) or not 0 < len(msg[key]) <= MAX_NAMES or not msg[key].isprintable():
+            if key == "team" and msg.get(key) == "":
+                continue
+            raise ValueError(f"hello without a printable robot {key} of at most {MAX_NAMES} characters")
     for key in ("width", "height"):
-        _num(msg, key)
+        if not BATTLEFIELD[0] <= _num(msg, key) <= BATTLEFIELD[1]:
+            raise ValueError(f"hello {key} {msg[key]!r} outside Robocode's {BATTLEFIELD[0]}-{BATTLEFIELD[1]}")
+    for key in ("round", "rounds"):
+        if isinstance(msg.get(key), bool) or not isinstance(msg.get(key), int):
+            raise ValueError(f"hello without an integer {key!r}")
+    if not 0 <= msg["round"] < msg["rounds"]:
+        raise ValueError(f"hello round {msg['round']} outside [0, rounds = {msg['rounds']})")
     return msg
 
 
@@ -204,6 +224,9 @@ def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
     if len(parts) != 4 or head[0] != "O" or len(head) != _OBS_FIELDS:
         raise ValueError(f"bad observation line: {line[:80]!r}")
     rnd, turn, others = int(head[1]), int(head[2]), int(head[11])
+    if rnd != hello["round"] or turn < 0 or others < 0:
+        raise ValueError(f"observation of round {rnd}, turn {turn}, others {others} on the connection of round "
+                         f"{hello['round']}")
     x, y, heading, gun, radar, vel, energy, heat = _floats(head[3:11], "state value")
     remaining = _finite(head[12], "distance_remaining")
     scans = []
@@ -266,14 +289,38 @@ def format_action(turn: int, action: Action) -> str:
     return "A " + str(turn) + " " + " ".join("NaN" if math.isnan(v) else repr(v) for v in vals) + "\n"
 
 
+def parse_end(line: str, hello: dict[str, Any]) -> tuple[int, tuple[int, ...], tuple[TurnEnergy, ...]]:
+    """Validate an ``E ...`` line: (round, (DECISIONS, RTT_TOTAL_US, RTT_OVER_1MS, TURNS, WORK_US), history).
+
+    The statistics go into a run's files, so they must be what a robot can report: counters >= 0, at most as
+    many slow round trips as decisions and as many decisions as turns, the round of the robot's hello."""
+    tab = line.split("\t")
+    parts = tab[0].split(" ")
+    if len(parts) != 10 or len(tab) != 2 or parts[0] != "E" or parts[3] not in ("death", "round_end"):
+        raise ValueError(f"bad end line: {line[:80]!r}")
+    rnd, time_ = int(parts[1]), int(parts[2])
+    if rnd != hello["round"]:
+        raise ValueError(f"end line for round {rnd} on the connection of round {hello['round']}")
+    energy = _finite(parts[4], "energy")
+    n, rtt, slow, turns, work = (int(v) for v in parts[5:])
+    if time_ < 0 or energy < 0 or not 0 <= slow <= n <= turns <= _STAT_MAX or not 0 <= rtt <= _STAT_MAX \
+            or not 0 <= work <= _STAT_MAX:
+        raise ValueError(f"end line with impossible statistics: {tab[0][:120]!r}")
+    return rnd, (n, rtt, slow, turns, work), parse_history(tab[1])
+
+
 @dataclass
 class BridgeStats:
-    """Counters of one server's life."""
+    """Counters of one server's life. ``errors`` are the sessions of robots that presented the token (at most
+    ``MAX_ERRORS`` kept, ``errors_dropped`` counts the rest); connections that never did are only counted in
+    ``rejected`` by reason, and nothing they sent reaches the policy."""
 
     connections: int = 0
     decisions: int = 0
     rounds_ended: int = 0
     errors: list[str] = field(default_factory=list)
+    errors_dropped: int = 0
+    rejected: dict[str, int] = field(default_factory=dict)
     policy_s: float = 0.0  # time inside the policy
     handling_s: float = 0.0  # the server's own time per decision: parse, format, send (policy excluded)
     # as the robots measured them (sums over the rounds they ended while connected)
@@ -283,9 +330,10 @@ class BridgeStats:
     robot_turns: int = 0
     work_us: int = 0
 
-    def add_round_end(self, fields: Sequence[str]) -> None:
-        """Add a robot's round statistics: DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US."""
-        n, rtt, slow, turns, work = (int(v) for v in fields)
+    def add_round_end(self, fields: Sequence[int]) -> None:
+        """Add a robot's round statistics (validated by :func:`parse_end`): DECISIONS RTT_TOTAL_US RTT_OVER_1MS
+        TURNS WORK_US."""
+        n, rtt, slow, turns, work = fields
         self.robot_decisions += n
         self.rtt_total_us += rtt
         self.rtt_over_1ms += slow
@@ -293,10 +341,43 @@ class BridgeStats:
         self.work_us += work
 
 
+class LineReader:
+    """Lines from a socket with a bounded buffer: a line longer than ``limit`` bytes raises ValueError as soon
+    as the buffer passes the limit (nothing beyond it is kept)."""
+
+    def __init__(self, sock: socket.socket, limit: int = MAX_LINE, first: bytes = b"") -> None:
+        self.sock, self.limit = sock, limit
+        self.buf = bytearray(first)
+
+    def readline(self) -> str | None:
+        """The next line without its newline (UTF-8), or None when the peer closed the connection."""
+        while True:
+            i = self.buf.find(b"\n")
+            if i >= 0:
+                line = bytes(self.buf[:i])
+                del self.buf[: i + 1]
+                return line.decode("utf-8")
+            if len(self.buf) > self.limit:
+                raise ValueError(f"line longer than {self.limit} bytes")
+            chunk = self.sock.recv(1 << 16)
+            if not chunk:
+                return None
+            self.buf += chunk
+
+
+@dataclass
+class _Pending:
+    deadline: float
+    buf: bytearray = field(default_factory=bytearray)
+
+
 class BridgeServer:
     """Serves one policy to every BridgeBot of a battle (team-mates share it) on 127.0.0.1.
 
-    One thread per robot connection with blocking reads (the fewest system calls per turn); policy
+    One thread accepts connections and reads their hellos without blocking: a hello must be complete within
+    ``HELLO_TIMEOUT_S`` and ``MAX_HELLO`` bytes, at most ``MAX_PENDING`` connections wait for theirs (a newer
+    one drops the oldest), and only a hello with the token starts a session. Each session is served by its own
+    thread with blocking reads (the fewest system calls per turn) of lines up to ``MAX_LINE`` bytes; policy
     calls are serialised by a lock, so the policy need not be thread-safe.
     """
 
@@ -309,12 +390,12 @@ class BridgeServer:
         self.token = token if token is not None else secrets.token_hex(16)
         self.stats = BridgeStats()
         self.on_hello: Callable[[dict], None] | None = None
-        self._listener = socket.create_server((LOOPBACK, port))
-        self._listener.settimeout(0.1)
+        self._listener = socket.create_server((LOOPBACK, port), backlog=256)
+        self._listener.setblocking(False)
         self.port: int = self._listener.getsockname()[1]
         self._stop = threading.Event()
         self._lock = threading.Lock()
-        self._conns: list[socket.socket] = []
+        self._conns: set[socket.socket] = set()
         self._thread: threading.Thread | None = None
 
     def start(self) -> BridgeServer:
@@ -324,34 +405,109 @@ class BridgeServer:
         return self
 
     def serve_forever(self) -> None:
-        """Accept robots until :meth:`stop`; each connection is served by its own thread."""
+        """Accept robots and read their hellos until :meth:`stop`; each session runs in its own thread."""
+        sel = selectors.DefaultSelector()
+        sel.register(self._listener, selectors.EVENT_READ)
+        pending: dict[socket.socket, _Pending] = {}  # insertion order: oldest first
         try:
             while not self._stop.is_set():
-                try:
-                    sock, _ = self._listener.accept()
-                except TimeoutError:
-                    continue
-                except OSError:
-                    break
-                sock.settimeout(None)
-                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                with self._lock:
-                    self.stats.connections += 1
-                    self._conns.append(sock)
-                threading.Thread(target=self._serve, args=(sock,), daemon=True).start()
+                ready = sel.select(timeout=0.1)
+                listening = False
+                for key, _ in ready:  # hellos first, so a burst of new connections cannot push them out
+                    if key.fileobj is self._listener:
+                        listening = True
+                    else:
+                        self._read_hello(key.fileobj, pending, sel)  # type: ignore[arg-type]
+                if listening:
+                    self._accept(pending, sel)
+                now = time.monotonic()
+                for sock in [s for s, p in pending.items() if p.deadline < now]:
+                    self._drop(sock, pending, sel, "no hello in time")
         finally:
+            for sock in list(pending):
+                self._drop(sock, pending, sel, None)
+            sel.close()
             self._listener.close()
+
+    def _accept(self, pending: dict[socket.socket, _Pending], sel: selectors.BaseSelector) -> None:
+        for _ in range(16):  # a few per pass, then the pending hellos are read again
+            try:
+                sock, _ = self._listener.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                if self._stop.is_set():
+                    return
+                raise
+            sock.setblocking(False)
+            while len(pending) >= MAX_PENDING:
+                self._drop(next(iter(pending)), pending, sel, "too many connections without a hello")
+            pending[sock] = _Pending(time.monotonic() + HELLO_TIMEOUT_S)
+            sel.register(sock, selectors.EVENT_READ)
+            self._read_hello(sock, pending, sel)  # a robot sends its hello right after connecting
+
+    def _drop(self, sock: socket.socket, pending: dict[socket.socket, _Pending], sel: selectors.BaseSelector,
+              reason: str | None) -> None:
+        pending.pop(sock, None)
+        with contextlib.suppress(KeyError, ValueError):
+            sel.unregister(sock)
+        sock.close()
+        if reason is not None:
+            with self._lock:
+                self.stats.rejected[reason] = self.stats.rejected.get(reason, 0) + 1
+
+    def _read_hello(self, sock: socket.socket, pending: dict[socket.socket, _Pending],
+                    sel: selectors.BaseSelector) -> None:
+        p = pending.get(sock)
+        if p is None:
+            return
+        try:
+            chunk = sock.recv(MAX_HELLO + 1 - len(p.buf))
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            self._drop(sock, pending, sel, "connection error before the hello")
+            return
+        if not chunk:
+            self._drop(sock, pending, sel, "closed before the hello")
+            return
+        p.buf += chunk
+        end = p.buf.find(b"\n")
+        if end < 0:
+            if len(p.buf) > MAX_HELLO:
+                self._drop(sock, pending, sel, "hello line too long")
+            return
+        try:
+            hello = parse_hello(p.buf[:end].decode("utf-8"), self.token)
+        except (ValueError, RecursionError) as err:  # JSON and Unicode errors are ValueErrors
+            self._drop(sock, pending, sel, "wrong token" if "token" in str(err) else "bad hello")
+            return
+        rest = bytes(p.buf[end + 1:])
+        pending.pop(sock)
+        sel.unregister(sock)
+        with self._lock:
+            if len(self._conns) >= MAX_ROBOTS:
+                full = True
+            else:
+                full = False
+                self._conns.add(sock)
+                self.stats.connections += 1
+        if full:
+            sock.close()
+            self._error(f"{hello['name']}: refused, {MAX_ROBOTS} robots already connected")
+            return
+        threading.Thread(target=self._serve, args=(sock, hello, rest), daemon=True).start()
 
     def stop(self) -> None:
         """Stop serving and close every socket."""
         self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5)
         with self._lock:
             for sock in self._conns:
                 with contextlib.suppress(OSError):
                     sock.shutdown(socket.SHUT_RDWR)
                 sock.close()
-        if self._thread is not None:
-            self._thread.join(timeout=5)
 
     def __enter__(self) -> BridgeServer:
         return self.start()
@@ -361,54 +517,61 @@ class BridgeServer:
 
     def _error(self, text: str) -> None:
         with self._lock:
-            self.stats.errors.append(text)
+            if len(self.stats.errors) < MAX_ERRORS:
+                self.stats.errors.append(text[:500])
+            else:
+                self.stats.errors_dropped += 1
 
-    def _serve(self, sock: socket.socket) -> None:
-        hello: dict[str, Any] | None = None
+    def _serve(self, sock: socket.socket, hello: dict[str, Any], rest: bytes) -> None:
+        """One robot's session after a valid hello: observations answered, one end line, then the socket closes."""
+        ended = False
         try:
-            with sock, sock.makefile("r", encoding="utf-8", newline="\n") as lines:
-                for line in lines:
-                    if len(line) > MAX_LINE:
-                        raise ValueError("line too long")
-                    line = line.rstrip("\n")
-                    if hello is None:
-                        hello = parse_hello(line, self.token)
-                        if self.on_hello is not None:
-                            self.on_hello(hello)
-                        sock.sendall(self._reply)
-                    elif line.startswith("E "):
-                        tab = line.split("\t")
-                        parts = tab[0].split(" ")
-                        if len(parts) != 10 or len(tab) != 2:
-                            raise ValueError(f"bad end line: {line[:80]!r}")
-                        history = parse_history(tab[1])
-                        with self._lock:
-                            self.stats.rounds_ended += 1
-                            self.stats.add_round_end(parts[5:])
-                            end = getattr(self.policy, "end_episode", None)
-                            if end is not None and self.settings.history:
-                                end(hello["name"], int(parts[1]), history)
-                            elif end is not None:  # e.g. a learner's last SMDP step of the round
-                                end(hello["name"], int(parts[1]))
-                    else:
-                        t0 = time.perf_counter()
-                        obs = parse_observation(line, hello)
-                        parsed = time.perf_counter()
-                        with self._lock:  # waiting here (team-mates' decisions) is counted nowhere
-                            t1 = time.perf_counter()
-                            action = self.policy(obs)
-                            t2 = time.perf_counter()
-                        sock.sendall(format_action(obs.turn, action).encode())
-                        t3 = time.perf_counter()
-                        with self._lock:
-                            self.stats.decisions += 1
-                            self.stats.policy_s += t2 - t1
-                            self.stats.handling_s += (parsed - t0) + (t3 - t2)
+            sock.settimeout(HELLO_TIMEOUT_S)  # the reply is small; a robot that does not read it is dropped
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            if self.on_hello is not None:
+                self.on_hello(hello)
+            sock.sendall(self._reply)
+            sock.settimeout(None)
+            lines = LineReader(sock, MAX_LINE, rest)
+            while (line := lines.readline()) is not None:
+                if line.startswith("E "):
+                    if ended:
+                        raise ValueError("a second end line on one connection")
+                    ended = True
+                    rnd, numbers, history = parse_end(line, hello)
+                    with self._lock:
+                        self.stats.rounds_ended += 1
+                        self.stats.add_round_end(numbers)
+                        end = getattr(self.policy, "end_episode", None)
+                        if end is not None and self.settings.history:
+                            end(hello["name"], rnd, history)
+                        elif end is not None:  # e.g. a learner's last SMDP step of the round
+                            end(hello["name"], rnd)
+                else:
+                    if ended:
+                        raise ValueError("an observation after the end line")
+                    t0 = time.perf_counter()
+                    obs = parse_observation(line, hello)
+                    parsed = time.perf_counter()
+                    with self._lock:  # waiting here (team-mates' decisions) is counted nowhere
+                        t1 = time.perf_counter()
+                        action = self.policy(obs)
+                        t2 = time.perf_counter()
+                    sock.sendall(format_action(obs.turn, action).encode())
+                    t3 = time.perf_counter()
+                    with self._lock:
+                        self.stats.decisions += 1
+                        self.stats.policy_s += t2 - t1
+                        self.stats.handling_s += (parsed - t0) + (t3 - t2)
         except OSError as err:
             if not self._stop.is_set():
-                self._error(f"{hello['name'] if hello else '?'}: connection: {err}")
+                self._error(f"{hello['name']}: connection: {err}")
         except Exception as err:  # a bad message or a failing policy ends this robot's session
-            self._error(f"{hello['name'] if hello else '?'}: {type(err).__name__}: {err}")
+            self._error(f"{hello['name']}: {type(err).__name__}: {err}")
+        finally:
+            with self._lock:
+                self._conns.discard(sock)
+            sock.close()
 
 
 def nearest_enemy_policy(obs: Observation) -> Action:
@@ -437,13 +600,15 @@ def load_policy(ref: str) -> Policy:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m confront.engine.bridge PORT TOKEN [module:function]``: serve in this process."""
+    """``python -m confront.engine.bridge PORT [module:function]``: serve in this process; the token is read
+    from the environment variable CONFRONT_BRIDGE_TOKEN (never from the command line, which every user sees)."""
     args = list(sys.argv[1:] if argv is None else argv)
-    if len(args) not in (2, 3):
+    token = os.environ.get(TOKEN_ENV, "")
+    if len(args) not in (1, 2) or not token:
         print(main.__doc__)
         return 2
-    policy = load_policy(args[2]) if len(args) == 3 else nearest_enemy_policy
-    server = BridgeServer(policy, token=args[1], port=int(args[0]))
+    policy = load_policy(args[1]) if len(args) == 2 else nearest_enemy_policy
+    server = BridgeServer(policy, token=token, port=int(args[0]))
     server.on_hello = lambda h: print(f"hello {h['name']} round {h['round']}", flush=True)
     print(f"ready {server.port}", flush=True)
     try:

@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 
 from confront.arena.control import ControlConfig
 from confront.engine.battle import BattleSpec
-from confront.engine.bridge import BridgeServer, BridgeSettings, Policy
+from confront.engine.bridge import TOKEN_ENV, BridgeServer, BridgeSettings, Policy
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 
 BRIDGE_BOT = "confront.BridgeBot*"
@@ -28,12 +28,14 @@ def bridge_timeout_ms(cpu_constant_ms: float) -> int:
 
 def bridge_options(options: EngineOptions, port: int, token: str, timeout_ms: int) -> EngineOptions:
     """Engine options for a bridged battle: sandbox off (sockets), where and how long to wait as system
-    properties (the decision interval and the controller come from the server's hello reply)."""
+    properties (the decision interval and the controller come from the server's hello reply), and the token in
+    the engine's environment (``CONFRONT_BRIDGE_TOKEN``): the command line is visible to every local user, a
+    process's environment only to its own."""
     if timeout_ms <= 0:
         raise ValueError(f"timeout_ms must be > 0, got {timeout_ms}")
-    props = (f"-Dconfront.bridge.port={port}", f"-Dconfront.bridge.token={token}",
-             f"-Dconfront.bridge.timeoutMs={timeout_ms}")
-    return replace(options, nosecurity=True, extra_jvm_args=options.extra_jvm_args + props)
+    props = (f"-Dconfront.bridge.port={port}", f"-Dconfront.bridge.timeoutMs={timeout_ms}")
+    return replace(options, nosecurity=True, extra_jvm_args=options.extra_jvm_args + props,
+                   env=(*options.env, (TOKEN_ENV, token)))
 
 
 @dataclass(frozen=True)
@@ -52,6 +54,7 @@ class BridgedRun:
     connections: int
     server_errors: tuple[str, ...]
     failures: tuple[str, ...]
+    rejected: int = 0  # connections dropped before a valid hello (wrong token, no hello, too long, ...)
     rtt_mean_us: float = float("nan")
     rtt_over_1ms: int = 0
     work_us_per_turn: float = float("nan")
@@ -99,6 +102,7 @@ def run_bridged_battle(
     nan = float("nan")
     return BridgedRun(run=run, decisions=st.decisions, connections=st.connections,
                       server_errors=tuple(st.errors), failures=bridge_failures(run),
+                      rejected=sum(st.rejected.values()),
                       rtt_mean_us=st.rtt_total_us / st.robot_decisions if st.robot_decisions else nan,
                       rtt_over_1ms=st.rtt_over_1ms,
                       work_us_per_turn=st.work_us / st.robot_turns if st.robot_turns else nan,

@@ -33,6 +33,9 @@ class EngineOptions:
     max_heap_mb: int = 512
     timeout_s: float = 900.0
     extra_jvm_args: tuple[str, ...] = ()
+    # extra environment variables of the engine process (e.g. the bridge token: unlike the command line, a
+    # process's environment is readable only by its user); kept out of repr
+    env: tuple[tuple[str, str], ...] = field(default=(), repr=False)
     round_start_fix: bool = True  # RoundStartAgent: no lost wake-up wait at round start (docs/engine.md)
 
     def __post_init__(self) -> None:
@@ -102,10 +105,13 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child between 
         pass
 
 
-def run_process(cmd: Sequence[str], timeout_s: float, cwd: Path, log: Path) -> int:
-    """Run ``cmd`` in its own process group; kill the whole group on timeout, error or Ctrl-C."""
+def run_process(cmd: Sequence[str], timeout_s: float, cwd: Path, log: Path,
+                env: Mapping[str, str] | None = None) -> int:
+    """Run ``cmd`` in its own process group (``env``: variables added to this process's environment); kill the
+    whole group on timeout, error or Ctrl-C."""
+    full_env = {**os.environ, **env} if env else None
     with open(log, "wb") as out:
-        proc = subprocess.Popen(list(cmd), cwd=cwd, stdout=out, stderr=subprocess.STDOUT,
+        proc = subprocess.Popen(list(cmd), cwd=cwd, env=full_env, stdout=out, stderr=subprocess.STDOUT,
                                 stdin=subprocess.DEVNULL, start_new_session=True,
                                 preexec_fn=_die_with_parent if sys.platform == "linux" else None)
         try:
@@ -174,7 +180,8 @@ def run_battle(
         if trace is not None:
             args.append(str(Path(trace).resolve()))
         log = run_dir / "engine.log"
-        code = run_process(java_command(install, classes, wd, opts) + args, opts.timeout_s, run_dir, log)
+        code = run_process(java_command(install, classes, wd, opts) + args, opts.timeout_s, run_dir, log,
+                           env=dict(opts.env))
         if not summary_file.is_file():
             tail = log.read_text(errors="replace")[-2000:]
             raise RuntimeError(f"engine run failed (exit {code}) without a summary:\n{tail}")

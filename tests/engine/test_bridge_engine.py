@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import threading
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 from confront.engine.battle import BattleSpec, scenario_battle
-from confront.engine.bridge import Observation, TurnEnergy, nearest_enemy_policy
+from confront.engine.bridge import TOKEN_ENV, Observation, TurnEnergy, nearest_enemy_policy
 from confront.engine.bridged import BRIDGE_BOT, bridge_failures, bridge_options, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.runner import EngineOptions, run_battle
@@ -73,7 +74,8 @@ def test_stalling_python_falls_back(install) -> None:
 
 def test_python_killed_mid_battle(install) -> None:
     server = subprocess.Popen(
-        [sys.executable, "-m", "confront.engine.bridge", "0", "secret"], stdout=subprocess.PIPE, text=True,
+        [sys.executable, "-m", "confront.engine.bridge", "0"], stdout=subprocess.PIPE, text=True,
+        env={**os.environ, TOKEN_ENV: "secret"},
     )
     try:
         port = int(server.stdout.readline().split()[1])  # "ready PORT"

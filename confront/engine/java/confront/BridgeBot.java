@@ -29,7 +29,8 @@ import robocode.util.Utils;
  * A tank that takes its decisions from a Python policy over a loopback TCP socket.
  *
  * Settings come from JVM system properties (the engine runs with -DNOSECURITY=true so that robots may use
- * sockets): confront.bridge.port, confront.bridge.token, confront.bridge.timeoutMs. Protocol version 2
+ * sockets): confront.bridge.port, confront.bridge.timeoutMs; the token from the engine's environment variable
+ * CONFRONT_BRIDGE_TOKEN (a command line is visible to every local user, an environment only to its own). Protocol version 2
  * (format in confront/engine/bridge.py), one line per message: the robot sends a JSON "hello" once per round
  * and Python answers "OK 2 EVERY LEAD HISTORY N" plus N "key value" lines of the fixed gun/radar controller
  * (N = 0: none); with HISTORY = 1 the robot records every turn's energies and sends them with the next message.
@@ -133,7 +134,7 @@ public class BridgeBot extends TeamRobot {
             socket.setSoTimeout(timeout);
             in = new BufferedReader(new InputStreamReader(socket.getInputStream(), StandardCharsets.UTF_8));
             out2 = socket.getOutputStream();
-            send("{\"v\":" + VERSION + ",\"type\":\"hello\",\"token\":" + str(System.getProperty("confront.bridge.token", ""))
+            send("{\"v\":" + VERSION + ",\"type\":\"hello\",\"token\":" + str(token())
                     + ",\"name\":" + str(getName()) + ",\"team\":" + str(teamName())
                     + ",\"round\":" + getRoundNum() + ",\"rounds\":" + getNumRounds()
                     + ",\"width\":" + getBattleFieldWidth() + ",\"height\":" + getBattleFieldHeight() + "}");
@@ -157,6 +158,12 @@ public class BridgeBot extends TeamRobot {
         } catch (IOException | RuntimeException e) {
             fail("connect: " + e.getClass().getSimpleName() + ": " + e.getMessage());
         }
+    }
+
+    /** The bridge token from the environment ("" if none: the server then refuses the hello). */
+    private static String token() {
+        String t = System.getenv("CONFRONT_BRIDGE_TOKEN");
+        return t == null ? "" : t;
     }
 
     /** The controller's "key value" lines (confront.engine.bridge.controller_lines) as a PolicyModel. */

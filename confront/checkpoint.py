@@ -1,11 +1,17 @@
 """Data-only checkpoints: a folder with ``state.npz`` (arrays) and ``meta.json`` (format version, counters,
-RNG states, the arrays' SHA-256), written atomically and verified on load. Never pickle.
+RNG states, the arrays' SHA-256 and a SHA-256 of the metadata itself), written atomically and verified on load.
+Never pickle.
 
 Layout inside a run folder::
 
     checkpoints/
       round-000120/state.npz, meta.json
       LATEST            # name of the newest complete checkpoint, replaced atomically
+
+An edited ``meta.json`` (say ``rounds_done``) fails its checksum and is refused; a ``rounds_done`` that does not
+fit the checkpoint's name or its rows is refused too (also for version-1 checkpoints, which had no metadata
+checksum). Saving removes only checkpoints older than the one saved; without ``LATEST`` the newest checkpoint
+that verifies is used, and that is said on stderr.
 """
 
 from __future__ import annotations
@@ -13,17 +19,22 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
+import sys
 import tempfile
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 FORMAT = "confront-checkpoint"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: meta.json carries meta_sha256; version 1 (without it) is still read
+READ_VERSIONS = (1, 2)
+NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}")
+ROUND_NAME = re.compile(r"round-(\d+)")
 
 
 class CheckpointError(RuntimeError):
@@ -48,6 +59,12 @@ def _sha256(path: Path) -> str:
         for chunk in iter(lambda: fh.read(1 << 20), b""):
             h.update(chunk)
     return h.hexdigest()
+
+
+def _meta_digest(meta: Mapping[str, Any]) -> str:
+    """SHA-256 of the metadata (without its own digest) in a canonical JSON form."""
+    body = {k: v for k, v in meta.items() if k != "meta_sha256"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
 
 def _fsync_dir(path: Path) -> None:
@@ -79,7 +96,12 @@ def write_atomic(path: Path, data: bytes) -> None:
 
 def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], meta: Mapping[str, Any],
          keep: int = 2) -> Path:
-    """Save a checkpoint ``directory/name`` atomically, point ``LATEST`` at it and keep the newest ``keep``."""
+    """Save a checkpoint ``directory/name`` atomically, point ``LATEST`` at it and keep the newest ``keep``.
+
+    Only checkpoints whose names sort before ``name`` are removed: a newer one (say, one written before a resume
+    from an older checkpoint) is never deleted."""
+    if not NAME.fullmatch(name):
+        raise ValueError(f"checkpoint name {name!r} must be letters, digits, '.', '_' or '-'")
     root = Path(directory)
     root.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(dir=root, prefix=f".{name}."))
@@ -90,7 +112,9 @@ def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], met
             fh.flush()
             os.fsync(fh.fileno())
         full_meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "sha256": _sha256(npz), **meta}
-        write_atomic(tmp / "meta.json", json.dumps(full_meta, indent=1, sort_keys=True).encode())
+        full_meta["meta_sha256"] = _meta_digest(full_meta)
+        # key order kept (not sorted), so rows come back with their columns in the order they were written
+        write_atomic(tmp / "meta.json", json.dumps(full_meta, indent=1).encode())
         final = root / name
         if final.exists():
             shutil.rmtree(final)
@@ -100,50 +124,88 @@ def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], met
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     write_atomic(root / "LATEST", (name + "\n").encode())
-    complete = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("."))
-    for old in complete[:-keep] if keep > 0 else []:
-        if old.name != name:
-            shutil.rmtree(old, ignore_errors=True)
+    older = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".") and p.name < name)
+    for old in older[: max(0, len(older) - (keep - 1))] if keep > 0 else []:
+        shutil.rmtree(old, ignore_errors=True)
     for stale in root.glob(".*"):  # leftovers of a save that was killed
         if stale.is_dir():
             shutil.rmtree(stale, ignore_errors=True)
     return final
 
 
-def latest(directory: str | Path) -> Path | None:
-    """The newest complete checkpoint in ``directory`` (by ``LATEST``), or None if there is none."""
+def _say(text: str) -> None:
+    print(f"note: {text}", file=sys.stderr, flush=True)
+
+
+def latest(directory: str | Path, notice: Callable[[str], None] | None = _say) -> Path | None:
+    """The newest complete checkpoint in ``directory``: the one ``LATEST`` names, or without ``LATEST`` the
+    newest that verifies (said through ``notice``); None if there is none."""
     root = Path(directory)
     pointer = root / "LATEST"
     if not pointer.exists():
+        if not root.is_dir():
+            return None
+        for cand in sorted((p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")), reverse=True):
+            try:
+                load(cand)
+            except CheckpointError:
+                continue
+            if notice is not None:
+                notice(f"{pointer} is missing; using {cand.name}, the newest checkpoint that verifies")
+            return cand
         return None
-    name = pointer.read_text().strip()
-    if not name or "/" in name or name.startswith("."):
-        raise CheckpointError(f"checkpoint pointer {pointer} is corrupt ({name!r})")
+    try:
+        name = pointer.read_text(encoding="utf-8").strip()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CheckpointError(f"checkpoint pointer {pointer} cannot be read ({exc})") from None
+    if not NAME.fullmatch(name):
+        raise CheckpointError(f"checkpoint pointer {pointer} is corrupt ({name[:100]!r})")
     return root / name
+
+
+def _check_counters(p: Path, meta: Mapping[str, Any]) -> None:
+    """A training checkpoint's ``rounds_done`` must fit its name (round-NNNNNN) and its rows."""
+    if "rounds_done" not in meta:
+        return
+    done = meta["rounds_done"]
+    if isinstance(done, bool) or not isinstance(done, int) or done < 0:
+        raise CheckpointError(f"checkpoint {p} has a bad rounds_done {done!r}")
+    m = ROUND_NAME.fullmatch(p.name)
+    if m is not None and int(m.group(1)) != done:
+        raise CheckpointError(f"checkpoint {p} says rounds_done = {done}, its name says {int(m.group(1))}")
+    rows = meta.get("rows")
+    if rows is not None and (not isinstance(rows, list) or len(rows) != done):
+        n = len(rows) if isinstance(rows, list) else type(rows).__name__
+        raise CheckpointError(f"checkpoint {p} says rounds_done = {done} but holds {n} rows")
 
 
 def load(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     """Load and verify a checkpoint folder; raise CheckpointError naming what is wrong."""
     p = Path(path)
     meta_path, npz_path = p / "meta.json", p / "state.npz"
-    if not meta_path.exists() or not npz_path.exists():
+    if not meta_path.is_file() or not npz_path.is_file():
         raise CheckpointError(f"checkpoint {p} is incomplete: it needs meta.json and state.npz")
     try:
-        meta = json.loads(meta_path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise CheckpointError(f"checkpoint {p} has a corrupt meta.json ({exc})") from None
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+    except (ValueError, RecursionError, OSError) as exc:  # JSON and Unicode errors are ValueErrors
+        raise CheckpointError(f"checkpoint {p} has a corrupt meta.json ({str(exc)[:200]})") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise CheckpointError(f"{p} is not a confront checkpoint")
-    if meta.get("format_version") != FORMAT_VERSION:
+    version = meta.get("format_version")
+    if isinstance(version, bool) or version not in READ_VERSIONS:
         raise CheckpointError(
-            f"checkpoint {p} has format version {meta.get('format_version')!r}; "
-            f"this confront reads version {FORMAT_VERSION}"
+            f"checkpoint {p} has format version {version!r}; "
+            f"this confront reads versions {', '.join(map(str, READ_VERSIONS))}"
         )
-    if _sha256(npz_path) != meta.get("sha256"):
-        raise CheckpointError(f"checkpoint {p} is corrupt or truncated: state.npz does not match its checksum")
+    if version >= 2 and meta.get("meta_sha256") != _meta_digest(meta):
+        raise CheckpointError(f"checkpoint {p} has an edited or corrupt meta.json: it does not match its checksum")
+    _check_counters(p, meta)
     try:
+        if _sha256(npz_path) != meta.get("sha256"):
+            raise CheckpointError(
+                f"checkpoint {p} is corrupt or truncated: state.npz does not match its checksum")
         with np.load(npz_path, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError, zipfile.BadZipFile) as exc:
-        raise CheckpointError(f"checkpoint {p} cannot be read: {exc}") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise CheckpointError(f"checkpoint {p} cannot be read: {str(exc)[:200]}") from None
     return arrays, meta

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 T = TypeVar("T")
+MAX_STRING = 4096  # characters of a string value
 
 
 class ConfigError(ValueError):
@@ -58,6 +59,10 @@ def _allowed(meta: Mapping[str, Any]) -> str:
 
 
 def _check_bounds(key: str, value: Any, meta: Mapping[str, Any]) -> None:
+    if isinstance(value, tuple | list):  # bounds of a list field apply to each item
+        for i, item in enumerate(value):
+            _check_bounds(f"{key}[{i}]", item, meta)
+        return
     choices = meta.get("choices")
     if choices and value not in choices:
         raise ConfigError(f"{key} = {value!r} is not allowed: use {_allowed(meta)}")
@@ -121,10 +126,16 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"{key} = {value!r} has the wrong type: expected a number")
+        if isinstance(value, int) and abs(value) > 2**53:
+            raise ConfigError(f"{key} = {value!r} is out of range: must be a number of at most 2^53 in size")
+        if not math.isfinite(value):
+            raise ConfigError(f"{key} = {value!r} is out of range: must be a finite number")
         return float(value)
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{key} = {value!r} has the wrong type: expected an integer")
+        if not -(2**63) <= value < 2**63:
+            raise ConfigError(f"{key} = {value!r} is out of range: must fit in 64 bits")
         return value
     if tp is bool:
         if not isinstance(value, bool):
@@ -133,6 +144,9 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
     if tp is str:
         if not isinstance(value, str):
             raise ConfigError(f"{key} = {value!r} has the wrong type: expected a string")
+        if len(value) > MAX_STRING or any(ord(c) < 32 and c != "\t" or c == "\x7f" for c in value):
+            raise ConfigError(f"{key} = {value[:60]!r} is not allowed: use at most {MAX_STRING} printable "
+                              "characters on one line")
         return value
     if isinstance(tp, type) and not isinstance(value, tp):
         raise ConfigError(f"{key} = {value!r} has the wrong type: expected {_type_name(tp)}")
@@ -192,7 +206,7 @@ def parse_override(text: str) -> dict[str, Any]:
         raise ConfigError(f"--set {text!r} has an empty key")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
-    except tomllib.TOMLDecodeError:
+    except (tomllib.TOMLDecodeError, RecursionError):
         value = raw
     out: dict[str, Any] = {}
     node = out
@@ -211,8 +225,40 @@ def load_toml(path: str | Path) -> dict[str, Any]:
             return tomllib.load(fh)
     except FileNotFoundError:
         raise ConfigError(f"config file {str(p)!r} does not exist") from None
+    except IsADirectoryError:
+        raise ConfigError(f"config file {str(p)!r} is a folder: give a TOML file") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"config file {str(p)!r} is not valid TOML: {exc}") from None
+        raise ConfigError(f"config file {str(p)!r} is not valid TOML: {str(exc).splitlines()[0]}") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"config file {str(p)!r} is not valid TOML: it is not UTF-8 text") from None
+    except RecursionError:
+        raise ConfigError(f"config file {str(p)!r} is nested too deeply") from None
+    except OSError as exc:
+        raise ConfigError(f"config file {str(p)!r} cannot be read: {exc.strerror}") from None
+
+
+_ESCAPES = {'"': '\\"', "\\": "\\\\", "\n": "\\n", "\t": "\\t", "\r": "\\r", "\b": "\\b", "\f": "\\f"}
+
+
+def toml_string(v: str) -> str:
+    """``v`` as a TOML basic string: quotes, backslashes and control characters escaped (a newline in a name
+    cannot break the file); a lone surrogate, which no TOML file can hold, is a ConfigError."""
+    out = []
+    for c in v:
+        if c in _ESCAPES:
+            out.append(_ESCAPES[c])
+        elif ord(c) < 32 or ord(c) == 127:
+            out.append(f"\\u{ord(c):04x}")
+        elif 0xD800 <= ord(c) <= 0xDFFF:
+            raise ConfigError(f"{v[:60]!r} holds a lone surrogate (not Unicode text)")
+        else:
+            out.append(c)
+    return '"' + "".join(out) + '"'
+
+
+def toml_key(k: str) -> str:
+    """A TOML key: bare when it can be, quoted otherwise."""
+    return k if k and all(c.isascii() and (c.isalnum() or c in "_-") for c in k) else toml_string(k)
 
 
 def to_toml(data: Mapping[str, Any]) -> str:
@@ -223,13 +269,13 @@ def to_toml(data: Mapping[str, Any]) -> str:
         if isinstance(v, bool):
             return "true" if v else "false"
         if isinstance(v, str):
-            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+            return toml_string(v)
         if isinstance(v, float):
             return repr(v) if math.isfinite(v) else ("inf" if v > 0 else "-inf" if v < 0 else "nan")
         if isinstance(v, list | tuple):
             return "[" + ", ".join(scalar(x) for x in v) + "]"
         if isinstance(v, Mapping):
-            return "{ " + ", ".join(f"{k} = {scalar(x)}" for k, x in v.items()) + " }"
+            return "{ " + ", ".join(f"{toml_key(k)} = {scalar(x)}" for k, x in v.items()) + " }"
         return str(v)
 
     def table(name: str, node: Mapping[str, Any]) -> None:
@@ -237,9 +283,9 @@ def to_toml(data: Mapping[str, Any]) -> str:
         subs = {k: v for k, v in node.items() if isinstance(v, Mapping)}
         if name and (plain or not subs):
             lines.append(f"\n[{name}]")
-        lines.extend(f"{k} = {scalar(v)}" for k, v in plain.items())
+        lines.extend(f"{toml_key(k)} = {scalar(v)}" for k, v in plain.items())
         for k, v in subs.items():
-            table(f"{name}.{k}" if name else k, v)
+            table(f"{name}.{toml_key(k)}" if name else toml_key(k), v)
 
     table("", data)
     return "\n".join(lines).lstrip("\n") + "\n"

@@ -6,6 +6,7 @@ Every free choice the paper leaves open is a key here, with its default and the 
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -14,6 +15,25 @@ from typing import Literal
 from confront.config import ConfigError, field, from_dict, load_toml, merge, parse_override, to_dict
 
 CONFIG_PACKAGE = "confront.experiments.configs"
+# confront.arena.bots.BOT_NAMES, repeated so that reading a config does not load the simulator (a test keeps
+# the two equal)
+SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy")
+RUN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
+
+
+def check_scenario(name: str) -> None:
+    """``arena.scenario`` must be a built-in scenario or a scenario TOML file that loads (ValueError if not)."""
+    from confront.arena.scenarios import load_scenario, scenario_names
+
+    if not name.endswith(".toml"):
+        if name not in scenario_names():
+            raise ValueError(f"arena.scenario = {name!r} is not allowed: use one of {', '.join(scenario_names())} "
+                             "or a scenario .toml file")
+        return
+    try:
+        load_scenario(name)
+    except (OSError, ValueError, TypeError, RecursionError) as exc:  # TOML and Unicode errors are ValueErrors
+        raise ValueError(f"arena.scenario = {name!r} cannot be used: {str(exc).splitlines()[0][:200]}") from None
 
 
 @dataclass
@@ -27,6 +47,9 @@ class ArenaSection:
     target: Literal["nearest", "weakest"] = "nearest"
     sensing: Literal["scanned", "true"] = field(
         "scanned", doc="what a tank knows of enemies: their last scan (a real robot's view) or the true state")
+
+    def __post_init__(self) -> None:
+        check_scenario(self.scenario)
 
 
 @dataclass
@@ -42,6 +65,12 @@ class OpponentSection:
     gamma: float = field(0.9, ge=0.0, le=1.0)
     exploit: float = field(0.9, ge=0.0, le=1.0, doc="TD team's epsilon-greedy exploitation threshold (paper's eps)")
 
+    def __post_init__(self) -> None:
+        for key, value, allowed in (("kind", self.kind, ("td", *SCRIPTED_BOTS)),
+                                    ("pretrain_against", self.pretrain_against, SCRIPTED_BOTS)):
+            if value not in allowed:
+                raise ValueError(f"opponent.{key} = {value!r} is not allowed: use one of {', '.join(allowed)}")
+
 
 @dataclass
 class LearnerSection:
@@ -56,7 +85,7 @@ class LearnerSection:
     t_min: float = field(0.01, gt=0.0, doc="temperature floor (Table 2: 0.01)")
     eta: float = field(0.9, ge=0.0, le=1.0, doc="annealing factor (Eq. 7; Table 2: 0.9)")
     backup: Literal["paper", "smdp"] = field("paper", doc="Eq. 8-10 as corrected in paper-notes §3, or textbook SMDP")
-    hidden: tuple[int, ...] = field((16,), doc="DMNN hidden layer sizes")
+    hidden: tuple[int, ...] = field((16,), ge=1, le=4096, doc="DMNN hidden layer sizes")
     awm: bool = field(True, doc="adaptive momentum (Eq. 23-24) on; off = plain back-propagation")
     nn_rate: float = field(0.9, gt=0.0, le=1.0, doc="NN learning rate without AWM (Table 2: 0.9)")
     momentum: float = field(0.95, ge=0.0, lt=1.0, doc="momentum constant beta (Table 2: 0.95)")
@@ -83,7 +112,7 @@ class TrainSection:
 
     rounds: int = field(500, ge=1, doc="rounds in total (paper: 500)")
     session_rounds: int = field(10, ge=1, doc="rounds per session (paper: 10)")
-    seed: int = field(0, ge=0)
+    seed: int = field(0, ge=0, le=2**32 - 1)
     checkpoint_every: int = field(50, ge=1, doc="rounds between checkpoints")
     replay: bool = field(True, doc="record the last round of battle 0 as a replay")
 
@@ -101,6 +130,9 @@ class ExperimentConfig:
     train: TrainSection = field(default_factory=TrainSection)
 
     def __post_init__(self) -> None:
+        if not RUN_NAME.fullmatch(self.name):
+            raise ValueError(f"name = {self.name[:60]!r} is not allowed: it names run folders, so use 1-64 letters, "
+                             "digits, '.', '_' or '-', starting with a letter or digit")
         if self.learner.t_min > self.learner.t_max:
             raise ValueError(
                 f"learner.t_min = {self.learner.t_min} must not exceed learner.t_max = {self.learner.t_max}"

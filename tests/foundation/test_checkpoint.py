@@ -55,6 +55,7 @@ def test_pickled_arrays_are_not_loaded(tmp_path: Path) -> None:
     np.savez(npz, obj=np.array([{"a": 1}], dtype=object))
     meta = json.loads((path / "meta.json").read_text())
     meta["sha256"] = ck._sha256(npz)
+    meta["meta_sha256"] = ck._meta_digest(meta)
     (path / "meta.json").write_text(json.dumps(meta))
     with pytest.raises(ck.CheckpointError, match="cannot be read"):
         ck.load(path)
@@ -68,3 +69,67 @@ def test_keeps_newest_and_cleans_partial_saves(tmp_path: Path) -> None:
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == ["LATEST", "round-000003", "round-000005"]
     assert ck.load(ck.latest(tmp_path))[0]["w"][0] == 5.0
+
+
+def _train_save(root: Path, done: int) -> Path:
+    rows = [{"round": i + 1, "score_ours": 1.0, "battle": 0} for i in range(done)]
+    return ck.save(root, f"round-{done:06d}", {"w": np.arange(3.0)}, {"rounds_done": done, "rows": rows})
+
+
+def test_edited_meta_is_refused_and_nothing_is_deleted(tmp_path: Path) -> None:
+    for done in (100, 200, 300):
+        _train_save(tmp_path, done)
+    path = ck.latest(tmp_path)
+    meta_path = path / "meta.json"
+    meta = json.loads(meta_path.read_text())
+    meta["rounds_done"] = 1300
+    meta_path.write_text(json.dumps(meta))
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    with pytest.raises(ck.CheckpointError, match="edited or corrupt meta.json"):
+        ck.load(path)
+    meta["meta_sha256"] = ck._meta_digest(meta)  # a consistent-looking digest still disagrees with the rows
+    meta_path.write_text(json.dumps(meta))
+    before[meta_path] = meta_path.read_bytes()
+    with pytest.raises(ck.CheckpointError, match="rounds_done = 1300"):
+        ck.load(path)
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+
+
+def test_version_1_checkpoints_are_read_with_the_cross_checks(tmp_path: Path) -> None:
+    path = _train_save(tmp_path, 5)
+    meta = json.loads((path / "meta.json").read_text())
+    meta["format_version"] = 1
+    del meta["meta_sha256"]
+    (path / "meta.json").write_text(json.dumps(meta))
+    assert ck.load(path)[1]["rounds_done"] == 5
+    meta["rounds_done"] = 6
+    (path / "meta.json").write_text(json.dumps(meta))
+    with pytest.raises(ck.CheckpointError, match="name says 5"):
+        ck.load(path)
+
+
+def test_saving_an_older_round_keeps_newer_checkpoints(tmp_path: Path) -> None:
+    for done in (100, 200, 300):
+        _train_save(tmp_path, done)
+    _train_save(tmp_path, 150)  # e.g. after a resume from an older checkpoint
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["LATEST", "round-000150", "round-000200",
+                                                         "round-000300"]
+    assert ck.latest(tmp_path).name == "round-000150"
+
+
+def test_missing_latest_falls_back_to_the_newest_valid_checkpoint(tmp_path: Path) -> None:
+    for done in (100, 200):
+        _train_save(tmp_path, done)
+    (tmp_path / "LATEST").unlink()
+    (tmp_path / "round-000200" / "state.npz").write_bytes(b"broken")
+    said: list[str] = []
+    assert ck.latest(tmp_path, notice=said.append) == tmp_path / "round-000100"
+    assert len(said) == 1 and "round-000100" in said[0] and "LATEST is missing" in said[0]
+    (tmp_path / "round-000100" / "meta.json").unlink()
+    assert ck.latest(tmp_path, notice=said.append) is None and len(said) == 1
+
+
+def test_checkpoint_rows_keep_their_column_order(tmp_path: Path) -> None:
+    rows = [{"zeta": 1, "alpha": 2, "mid": 3}]
+    path = ck.save(tmp_path, "round-000001", {"w": np.zeros(1)}, {"rounds_done": 1, "rows": rows})
+    assert list(ck.load(path)[1]["rows"][0]) == ["zeta", "alpha", "mid"]

@@ -39,7 +39,7 @@ import hashlib
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numba
 import numpy as np
@@ -65,10 +65,12 @@ from .observe import (
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
 from .state import SCORE_PARTS
+from .tank import LEADS, MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_kernel
 
-__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER"]
+__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
 
 LEARNER = "td"  # opponents value meaning "learning tanks driven by the caller"
+REWARDS = {"eq35": 0, "score": 1}  # per-turn reward: Eq. 35 against the target, or the team's score margin
 
 
 @dataclass(frozen=True)
@@ -81,17 +83,28 @@ class SMDPConfig:
     auto_reset: bool = True
     observation: ObservationConfig = field(default_factory=ObservationConfig)
     control: ControlConfig = field(default_factory=ControlConfig)
+    reward: Literal["eq35", "score"] = "eq35"
+    tank: TankSpace | None = None  # the tank view and tank actions (confront.arena.tank) instead of the paper's
 
     def __post_init__(self) -> None:
         if not isinstance(self.turns_per_step, int) or self.turns_per_step < 1:
             raise ValueError(f"turns_per_step must be an integer >= 1, got {self.turns_per_step!r}")
         if not self.fire_powers or any(not 0.1 <= p <= 3.0 for p in self.fire_powers):
             raise ValueError(f"fire_powers must be non-empty values in [0.1, 3], got {self.fire_powers!r}")
+        if self.reward not in REWARDS:
+            raise ValueError(f"reward must be one of {', '.join(REWARDS)}, got {self.reward!r}")
+        if self.tank is not None and self.observation.sensing != "scanned":
+            raise ValueError("the tank view needs sensing='scanned' (what a real robot knows)")
+
+    @property
+    def paper_actions(self) -> int:
+        """4 moves, or 4 moves x fire powers; action a = power_index * 4 + move."""
+        return N_MOVES * (len(self.fire_powers) if self.fire_power_actions else 1)
 
     @property
     def n_actions(self) -> int:
-        """4 moves, or 4 moves x fire powers; action a = power_index * 4 + move."""
-        return N_MOVES * (len(self.fire_powers) if self.fire_power_actions else 1)
+        """Actions of a learning tank: the tank actions' joint count, or the paper's."""
+        return self.tank.n_actions if self.tank is not None else self.paper_actions
 
 
 @dataclass
@@ -160,7 +173,10 @@ class TeamBattleEnv:
         opponents: str | list[str] | tuple[str, ...] | None = None,
         config: SMDPConfig | None = None,
         order: str = "engine",
+        opponent_actions: Literal["same", "paper"] = "same",
     ) -> None:
+        """``opponent_actions``: caller-driven opponents ("td") act in the learners' action space ("same") or
+        in the paper's 4 (x powers) macro moves ("paper", e.g. a TD team beside tank-action learners)."""
         self.scenario = get_scenario(scenario) if isinstance(scenario, str) else scenario
         self.config = config or SMDPConfig()
         self.arena = Arena(self.scenario, n_battles, seed=seed, order=order)
@@ -176,17 +192,26 @@ class TeamBattleEnv:
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._recording: tuple[Replay, int] | None = None
         b, r = self.n_battles, self.n_robots
+        if opponent_actions not in ("same", "paper"):
+            raise ValueError(f"opponent_actions must be 'same' or 'paper', got {opponent_actions!r}")
         self._move = np.zeros((b, r, 2))
-        self._move_table = np.stack(move_commands(np.arange(N_MOVES), self.config.control), axis=-1)
         self._power = np.zeros((b, r))
-        self._memory = np.zeros((b, 3, r, r))  # x, y, energy of each robot at each robot's last scan of it
+        self._chosen = np.full((b, r), -1, dtype=np.int64)  # the step's chosen target robot (-1: by rule)
+        tank = self.config.tank
+        self._tables, self._space, self._n_act = _action_tables(self.config, self.learner, self.team,
+                                                                opponent_actions)
+        k = tank.enemy_slots if tank is not None else 1
+        self._slots = np.full((b, r, k), -1, dtype=np.int64)  # which robot fills each enemy slot of the view
+        self._memory = np.zeros((b, MEMORY_ROWS, r, r))  # each robot at each robot's last scan of it (tank.py)
         self._sensing = SENSING[self.config.observation.sensing]
         self._turn_buf = np.zeros((4, b, r))  # per turn: target, own energy, target energy, live
         self._kinds = self.bots.kinds.astype(np.int64) if self.bots is not None else np.zeros(r, np.int64)
         self._rule = TARGET_RULES[self.config.observation.target]
         c = self.config.control
         self._ctrl = np.array([c.radar_overshoot, c.aim_tolerance, c.power_near, c.power_mid, c.power_far,
-                               c.near_distance, c.far_distance, float(c.fire)])
+                               c.near_distance, c.far_distance, float(c.fire),
+                               float(LEADS[tank.lead]) if tank is not None else 0.0,
+                               float(REWARDS[self.config.reward])])
         p, a = self.arena.state.packed, self.arena
         threads = numba.get_num_threads()
         chunks = threads if b >= _PARALLEL_MIN_BATTLES and threads > 1 else 1
@@ -218,8 +243,19 @@ class TeamBattleEnv:
 
     @property
     def n_features(self) -> int:
-        """Feature vector length F."""
-        return self.config.observation.n_features
+        """Feature vector length F (the tank view's with tank actions, else the paper's)."""
+        tank = self.config.tank
+        return tank.n_features if tank is not None else self.config.observation.n_features
+
+    @property
+    def action_dims(self) -> tuple[int, ...]:
+        """Sizes of the action heads whose mixed-radix product is the joint action (tank actions: 4 heads)."""
+        tank = self.config.tank
+        return tank.dims if tank is not None else (self.n_actions,)
+
+    def opponent_n_actions(self) -> int:
+        """Actions of the caller-driven opponents (``opponent_actions``)."""
+        return int(self._n_act[1])
 
     @property
     def turns_per_step(self) -> int:
@@ -228,10 +264,25 @@ class TeamBattleEnv:
 
     # ------------------------------------------------------------------ observations
     def observe(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(target, discrete, features) of the current state for every robot."""
+        """(target, discrete, features) of the current state for every robot (features: the tank view with
+        tank actions, whose enemy slot maps then go to ``slots``)."""
         s = self.arena.state
-        return observe(s.x, s.y, s.heading, s.energy, s.alive, self.team, self.field, self.config.observation,
-                       self._memory, s.scan_time)
+        target, disc, feats = observe(s.x, s.y, s.heading, s.energy, s.alive, self.team, self.field,
+                                      self.config.observation, self._memory, s.scan_time)
+        tank = self.config.tank
+        if tank is None:
+            return target, disc, feats
+        view = np.empty(s.x.shape + (tank.n_features,), np.float32)
+        team_b = np.ascontiguousarray(np.broadcast_to(self.team, s.x.shape))
+        tank_view_kernel(s.x, s.y, s.heading, s.velocity, s.energy, s.gun_heat, s.alive, team_b, self._memory,
+                         s.scan_time, s.time.astype(np.float64), self.field[0], self.field[1], tank.enemy_slots,
+                         tank.mate_slots, view, self._slots)
+        return target, disc, view
+
+    @property
+    def slots(self) -> np.ndarray:
+        """(B, R, K) robot in each enemy slot of the current tank views (-1 = empty)."""
+        return self._slots
 
     def reset(self, seed: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Start new battles (totals cleared; reseeded when ``seed`` is given): (discrete, features)."""
@@ -241,6 +292,7 @@ class TeamBattleEnv:
         if seed is not None:
             self.arena.seed(seed)
         self.arena.new_battle()
+        self._memory[...] = 0.0
         if self.bots is not None:
             self.bots.reset()
         target, disc, feats = self.observe()
@@ -252,6 +304,7 @@ class TeamBattleEnv:
         m = np.asarray(mask, dtype=bool)
         if m.any():
             self.arena.reset(m)  # scripted bots clear their memory on the new round themselves
+            self._memory[m] = 0.0
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats
@@ -293,15 +346,19 @@ class TeamBattleEnv:
         T = self.config.turns_per_step
         active = np.empty((self.n_battles, self.n_robots), dtype=np.bool_)
         p = self.arena.state.packed
-        if _prepare(a, self.learner, p["rb"], p["bb"], self._move_table, self._powers,
-                    self.config.fire_power_actions, self.n_actions, self._move, self._power, active):
-            la = a[:, self.learner]
-            raise ValueError(f"actions must be in 0..{self.n_actions - 1}, got [{la.min()}, {la.max()}]")
+        if _prepare(a, self._space, p["rb"], p["bb"], self._tables, self._n_act, self._slots, self._move,
+                    self._power, self._chosen, active):
+            for space, who in ((0, "learning tanks"), (1, "caller-driven opponents")):
+                la = a[:, self._space == space]
+                if la.size and (la.min() < 0 or la.max() >= self._n_act[space]):
+                    raise ValueError(f"actions of the {who} must be in 0..{self._n_act[space] - 1}, "
+                                     f"got [{la.min()}, {la.max()}]")
         rewards = np.zeros((self.n_battles, self.n_robots, T))
         self._sync_bots()
         shape = (self.n_battles, self.n_robots)
         obs = (np.empty(shape, np.int64), np.empty(shape, np.int64),
-               np.empty(shape + (self.n_features,), np.float32))
+               np.empty(shape + (self.config.observation.n_features,), np.float32),
+               np.empty(shape + (self.n_features if self.config.tank is not None else 1,), np.float32))
         if self._recording is None:
             self._run_turns(0, T, rewards, obs)
         else:
@@ -316,9 +373,11 @@ class TeamBattleEnv:
         """Turns t0..t1-1 of the SMDP step in the compiled kernel (then observations into ``obs``);
         battle ranges run in parallel threads when there are enough battles."""
         head = (t0, t1, self.learner, self._kinds, self.bots is not None, self._rule,
-                self.config.observation.reward_guard, self._move, self._power, self._ctrl, self._memory,
-                self._sensing)
-        tail = (rewards, self.max_distance, *obs)
+                self.config.observation.reward_guard, self._move, self._power, self._chosen, self._ctrl,
+                self._memory, self._sensing)
+        tank = self.config.tank
+        view = (tank.enemy_slots, tank.mate_slots) if tank is not None else (0, 0)
+        tail = (rewards, self.max_distance, *obs, *view, self._slots)
         if len(self._ranges) == 1:
             return _smdp_turns(0, self.n_battles, *head, *self._kargs, self._rems[0], *self._kargs_end, *tail)
         futures = [_pool().submit(_smdp_turns, lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
@@ -327,7 +386,8 @@ class TeamBattleEnv:
 
     def _finish(self, rewards: np.ndarray, active: np.ndarray, obs: tuple[np.ndarray, ...]) -> StepResult:
         s = self.arena.state.arrays
-        target, disc, feats = obs
+        target, disc, paper, view = obs
+        feats = view if self.config.tank is not None else paper
         round_done = s["done"].copy()
         truncated = round_done & ~s["decided"]
         terminated = ~s["alive"] | round_done[:, None]
@@ -340,6 +400,7 @@ class TeamBattleEnv:
             if self.config.auto_reset:
                 res.final_discrete, res.final_features = disc.copy(), feats.copy()
                 self.arena.reset(round_done)  # scripted bots clear their memory on the new round themselves
+                self._memory[round_done] = 0.0
                 target, disc, feats = self.observe()
                 res.discrete, res.features, res.target = disc, feats, target
         self._last = (res.target, res.discrete, res.features)
@@ -350,6 +411,7 @@ class TeamBattleEnv:
         """Arena arrays, the robots' scan memory and the scripted bots' memory (data only)."""
         d = {f"arena.{k}": v for k, v in self.arena.state_dict().items()}
         d["control.memory"] = self._memory.copy()
+        d["control.slots"] = self._slots.copy()
         if self.bots is not None:
             d.update({f"bots.{k}": v for k, v in self.bots.state_dict().items()})
         return d
@@ -362,6 +424,8 @@ class TeamBattleEnv:
         if d["control.memory"].shape != self._memory.shape:
             raise ValueError(f"control.memory has shape {d['control.memory'].shape}, expected {self._memory.shape}")
         self._memory[...] = d["control.memory"]
+        if "control.slots" in d and d["control.slots"].shape == self._slots.shape:
+            self._slots[...] = d["control.slots"]
         if self.bots is not None:
             self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
         self._last = self.observe()
@@ -399,27 +463,49 @@ def _purge_stale_cache() -> None:
 
 
 _purge_stale_cache()
-C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE = range(8)
+C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_LEAD, C_REWARD = range(10)
+
+
+def _action_tables(cfg: SMDPConfig, learner: np.ndarray, team: np.ndarray, opponent_actions: str
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Action tables (2, A, 4) of (distance, body turn, fire power, target slot) rows, 0 = the learners',
+    1 = the caller-driven opponents'; each robot's table (R,) (-1: scripted); actions per table (2,).
+    Fire power 0 = by distance (the paper's controller), -1 = hold fire; slot -1 = the target rule's."""
+    dist, turn = move_commands(np.arange(N_MOVES), cfg.control)
+    a = np.arange(cfg.paper_actions)
+    powers = np.asarray(cfg.fire_powers)[a // N_MOVES] if cfg.fire_power_actions else np.zeros(a.size)
+    paper = np.stack([dist[a % N_MOVES], turn[a % N_MOVES], powers, np.full(a.size, -1.0)], axis=1)
+    ours = action_table(cfg.tank) if cfg.tank is not None else paper
+    theirs = paper if opponent_actions == "paper" else ours
+    tables = np.zeros((2, max(len(ours), len(theirs)), 4))
+    tables[0, :len(ours)], tables[1, :len(theirs)] = ours, theirs
+    space = np.where(learner, np.where(team == 0, 0, 1), -1).astype(np.int64)
+    return tables, space, np.array([len(ours), len(theirs)], dtype=np.int64)
 
 
 @njit(cache=True)
-def _prepare(actions: np.ndarray, learner: np.ndarray, rb: np.ndarray, bb: np.ndarray, table: np.ndarray,
-             powers: np.ndarray, fire_power: bool, n_actions: int, move: np.ndarray, power: np.ndarray,
+def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndarray, tables: np.ndarray,
+             n_act: np.ndarray, slots: np.ndarray, move: np.ndarray, power: np.ndarray, chosen: np.ndarray,
              active: np.ndarray) -> bool:
-    """Learning tanks' move (distance, body turn) and fire power for the step, and ``active`` (a learning
-    tank alive in a battle not done). Returns True, changing nothing, if an action is out of range."""
+    """Learning tanks' move (distance, body turn), fire power and chosen target robot for the step (from
+    their action table and the enemy slots of their last view), and ``active`` (a learning tank alive in a
+    battle not done). Returns True, changing nothing, if an action is out of range."""
     nb, n = actions.shape
     for b in range(nb):
         for i in range(n):
-            if learner[i] and not 0 <= actions[b, i] < n_actions:
+            if space[i] >= 0 and not 0 <= actions[b, i] < n_act[space[i]]:
                 return True
     for b in range(nb):
         for i in range(n):
-            a = actions[b, i] if learner[i] else 0
-            move[b, i, 0] = table[a % N_MOVES, 0]
-            move[b, i, 1] = table[a % N_MOVES, 1]
-            power[b, i] = powers[a // N_MOVES] if fire_power else 0.0
-            active[b, i] = learner[i] and rb[b, K.ALIVE, i] and not bb[b, K.DONE]
+            sp = space[i]
+            a = actions[b, i] if sp >= 0 else 0
+            row = tables[max(sp, 0), a]
+            move[b, i, 0] = row[0]
+            move[b, i, 1] = row[1]
+            power[b, i] = row[2]
+            k = int(row[3])
+            chosen[b, i] = slots[b, i, k] if sp >= 0 and 0 <= k < slots.shape[2] else -1
+            active[b, i] = sp >= 0 and rb[b, K.ALIVE, i] and not bb[b, K.DONE]
     return False
 
 _PARALLEL_MIN_BATTLES = 8
@@ -446,7 +532,8 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
     target ``tgt`` known at (tx, ty).
 
     The radar turns to the target plus an overshoot, the gun to the target; the tank fires when the gun
-    is within the tolerance, the gun is cold and it has energy; power by distance band, or ``power`` > 0.
+    is within the tolerance, the gun is cold and it has energy; power by distance band, or ``power`` > 0;
+    never with ``power`` < 0 (hold fire).
     Without a target the radar spins a full turn and the gun keeps its command.
     """
     if tgt < 0:
@@ -463,7 +550,7 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
     cmd[b, i, 2] = gun_turn
     cmd[b, i, 3] = radar_turn
     fire = abs(gun_turn) <= ctrl[C_TOL] and rf[b, K.HEAT, i] == 0 and rf[b, K.E, i] > 0 and ctrl[C_FIRE] > 0
-    if not fire:
+    if not fire or power < 0:
         cmd[b, i, 4] = 0.0
     elif power > 0:
         cmd[b, i, 4] = power
@@ -476,18 +563,22 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
 
 
 @njit(cache=True, nogil=True)
-def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, ctrl, memory, sensing,
+def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
                 rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
                 placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
-                rewards, max_distance, target, disc, feats):
+                rewards, max_distance, target, disc, feats, view, k_slots, m_slots, slots):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
-    t = 0, then kept; gun/radar controller every turn), scripted bots, one Robocode turn, Eq. 35 rewards.
-    Then the observations of those battles' robots into target, disc, feats. Returns the turn index where
-    it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can run
-    in parallel threads. Each robot picks its target and aims from its own picture (observe.perceive_row);
-    after each turn the robots' scans go into ``memory``."""
+    t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
+    when ``ctrl[C_LEAD]``), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of the team's
+    score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
+    disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0). Returns the turn index
+    where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
+    run in parallel threads. Each robot picks its target and aims from its own picture
+    (observe.perceive_row); after each turn the robots' scans go into ``memory``."""
     n = rf.shape[2]
     vx, vy, ve, va = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    margin = ctrl[C_REWARD] > 0
+    before = np.zeros((b1 - b0, n))
     for t in range(t0, t1):
         any_live = False
         for b in range(b0, b1):
@@ -499,6 +590,9 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
                              scan_time[b], sensing, vx, vy, ve, va)
                 tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
+                c = chosen[b, i]
+                if c >= 0 and va[c]:
+                    tg = c
                 buf[0, b, i] = tg
                 buf[1, b, i] = rf[b, K.E, i]
                 buf[2, b, i] = rf[b, K.E, tg] if tg >= 0 else 0.0
@@ -511,8 +605,13 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     cmd[b, i, 3] = np.nan
                     cmd[b, i, 4] = 0.0
                     if rb[b, K.ALIVE, i]:
-                        controller_turn(rf, b, i, tg, vx[tg] if tg >= 0 else 0.0, vy[tg] if tg >= 0 else 0.0,
-                                        ctrl, power[b, i], cmd)
+                        tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
+                        if tg >= 0 and ctrl[C_LEAD] > 0 and sensing == 1:
+                            aim_power = power[b, i] if power[b, i] > 0 else 2.0
+                            tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, 3, i, tg],
+                                                memory[b, 4, i, tg], float(bi[b, K.TIME] - scan_time[b, i, tg]),
+                                                aim_power, width, height)
+                        controller_turn(rf, b, i, tg, tx, ty, ctrl, power[b, i], cmd)
                 else:
                     for c in range(4):
                         cmd[b, i, c] = np.nan
@@ -527,11 +626,25 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                       rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
                       rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
                       rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem)
+        if margin:
+            for b in range(b0, b1):
+                for i in range(n):
+                    before[b - b0, i] = score[b, i].sum()
         # one Robocode turn of these battles (what Arena.step runs)
         K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                      placements, placements_total, cmd, params, scratch_i, scratch_f)
         for b in range(b0, b1):
-            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], memory[b])
+            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V], memory[b])
+            if margin:
+                for i in range(n):
+                    if not learner[i]:
+                        continue
+                    m = 0.0
+                    for j in range(n):
+                        d = score[b, j].sum() - before[b - b0, j]
+                        m += d if ri[b, K.TEAM, j] == ri[b, K.TEAM, i] else -d
+                    rewards[b, i, t] = m
+                continue
             for i in range(n):
                 if buf[3, b, i] > 0:
                     tg = int(buf[0, b, i])
@@ -540,4 +653,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     r = slice(b0, b1)
     observe_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.E], rb[r, K.ALIVE], ri[r, K.TEAM], memory[r],
                    scan_time[r], sensing, rule, max_distance, width, height, target[r], disc[r], feats[r])
+    if k_slots > 0:
+        tank_view_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.V], rf[r, K.E], rf[r, K.HEAT], rb[r, K.ALIVE],
+                         ri[r, K.TEAM], memory[r], scan_time[r], bi[r, K.TIME].astype(np.float64), width, height,
+                         k_slots, m_slots, view[r], slots[r])
     return t1

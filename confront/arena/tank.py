@@ -1,0 +1,255 @@
+"""What a learning tank knows and chooses beyond the paper's model: the *tank view* and the *tank actions*.
+
+Angles follow Robocode: radians, 0 = north (+y), clockwise; x right, y up; distances in px, time in turns.
+
+Tank view (float32, ``n_features(K, M) = 11 + 9 K + 5 M``; 62 with K = 4 enemy slots, M = 3 mate slots),
+everything a real robot can know (its own getters, its radar's ScannedRobotEvents, team messages):
+
+| index | feature | scale |
+|---|---|---|
+| 0-3 | distance to the left, bottom, right, top wall: x/W, y/H, (W-x)/W, (H-y)/H | [0, 1] |
+| 4-5 | sin, cos of the own heading | [-1, 1] |
+| 6 | own velocity / 8 | [-1, 1] |
+| 7 | own energy / 100 | [0, ~2] |
+| 8 | gun heat / 3 (3.0 at a round's start) | [0, 1] |
+| 9 | enemies alive / enemies at the start | [0, 1] |
+| 10 | team-mates alive / team-mates at the start (0 without team-mates) | [0, 1] |
+| per enemy slot k (9 each): | the k-th nearest enemy known from a scan this round, nearest first | |
+| +0 | 1 when the slot holds an enemy (all nine 0 otherwise) | {0, 1} |
+| +1, +2 | sin, cos of its bearing from the own heading, from its last scanned position | [-1, 1] |
+| +3 | distance to that position / field diagonal | [0, 1] |
+| +4 | its lateral velocity at the scan, v sin(h_e - bearing) / 8 (+ = clockwise around us) | [-1, 1] |
+| +5 | its advancing velocity, v cos(h_e - bearing) / 8 (+ = away from us) | [-1, 1] |
+| +6 | its energy at the scan / 100 | [0, ~2] |
+| +7 | age of the scan, min(turns since, 50) / 50 | [0, 1] |
+| +8 | its energy drop between its last two scans, clip(drop, 0, 3) / 3 (it fired a bullet of that power) | [0, 1] |
+| per mate slot m (5 each): | the m-th nearest living team-mate, as it is (team messages) | |
+| +0 | 1 when the slot holds a team-mate | {0, 1} |
+| +1, +2 | sin, cos of its bearing from the own heading | [-1, 1] |
+| +3 | distance / field diagonal | [0, 1] |
+| +4 | its energy / 100 | [0, ~2] |
+
+Nothing names an opponent. The slot map ``slots`` (B, R, K) keeps which robot fills each enemy slot, so the
+action's target slot can be resolved to a robot.
+
+Tank actions: four heads, one joint integer ``((d * n_turns + t) * n_fire + f) * K + k``: a move distance
+(px, + ahead) and a body turn (rad, + clockwise) set once at the start of the T-turn step, a fire power
+(0 = hold fire), and the enemy slot to target. The fixed gun/radar controller (paper §6.1) then aims at
+that target every turn, optionally leading it linearly (``lead_point``), and fires with the chosen power
+when the gun is on target and cold.
+
+Scan memory rows (``memory`` (B, MEMORY_ROWS, R, R), ``[b, :, i, j]`` = robot j at robot i's last scan of
+it): x, y, energy, heading, velocity, energy drop since the previous scan, 1 when scanned this round.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numba import njit
+
+__all__ = ["TankSpace", "MEMORY_ROWS", "n_features", "tank_view_row", "tank_view_kernel", "lead_point",
+           "action_table", "FEATURE_NAMES"]
+
+MEMORY_ROWS = 7  # x, y, energy, heading, velocity, energy drop, scanned this round
+M_X, M_Y, M_E, M_H, M_V, M_DROP, M_SEEN = range(MEMORY_ROWS)
+OWN_FEATURES = 11
+ENEMY_FEATURES = 9
+MATE_FEATURES = 5
+MAX_AGE = 50.0  # turns: older scans read as 1
+WALL_MARGIN = 18.0  # half a robot: a tank's centre never gets closer to a wall (Robocode's 36 px body)
+LEADS = {"none": 0, "linear": 1}
+
+
+def n_features(k: int, m: int) -> int:
+    """Length of the tank view with k enemy slots and m mate slots."""
+    return OWN_FEATURES + ENEMY_FEATURES * k + MATE_FEATURES * m
+
+
+def feature_names(k: int, m: int) -> list[str]:
+    """Names of the tank view's entries, in order."""
+    names = ["wall_left", "wall_bottom", "wall_right", "wall_top", "sin_heading", "cos_heading", "velocity",
+             "energy", "gun_heat", "enemies_alive", "mates_alive"]
+    for s in range(k):
+        names += [f"enemy{s}_{n}" for n in ("present", "sin_bearing", "cos_bearing", "distance", "lateral",
+                                             "advancing", "energy", "age", "drop")]
+    for s in range(m):
+        names += [f"mate{s}_{n}" for n in ("present", "sin_bearing", "cos_bearing", "distance", "energy")]
+    return names
+
+
+FEATURE_NAMES = feature_names(4, 3)
+
+
+@dataclass(frozen=True)
+class TankSpace:
+    """The tank actions' values and the tank view's slots."""
+
+    distances: tuple[float, ...] = (-150.0, -50.0, 0.0, 50.0, 150.0)  # px, + ahead
+    turns_deg: tuple[float, ...] = (-90.0, -30.0, 0.0, 30.0, 90.0)  # body turn, + clockwise
+    fire_powers: tuple[float, ...] = (0.0, 1.0, 2.0, 3.0)  # 0 = hold fire
+    enemy_slots: int = 4  # K
+    mate_slots: int = 3  # M
+    lead: Literal["none", "linear"] = "linear"
+
+    def __post_init__(self) -> None:
+        for name in ("distances", "turns_deg", "fire_powers"):
+            v = getattr(self, name)
+            if not v or not all(isinstance(x, int | float) and math.isfinite(x) for x in v):
+                raise ValueError(f"tank.{name} must be a non-empty list of finite numbers, got {v!r}")
+        if any(not (p == 0 or 0.1 <= p <= 3.0) for p in self.fire_powers):
+            raise ValueError(f"tank.fire_powers must be 0 (hold) or in [0.1, 3], got {self.fire_powers!r}")
+        if any(abs(d) > 1000 for d in self.distances) or any(abs(t) > 360 for t in self.turns_deg):
+            raise ValueError("tank.distances must be within +-1000 px and tank.turns_deg within +-360")
+        if not isinstance(self.enemy_slots, int) or not 1 <= self.enemy_slots <= 16:
+            raise ValueError(f"tank.enemy_slots must be an integer in 1..16, got {self.enemy_slots!r}")
+        if not isinstance(self.mate_slots, int) or not 0 <= self.mate_slots <= 16:
+            raise ValueError(f"tank.mate_slots must be an integer in 0..16, got {self.mate_slots!r}")
+        if self.lead not in LEADS:
+            raise ValueError(f"tank.lead must be one of {', '.join(LEADS)}, got {self.lead!r}")
+
+    @property
+    def dims(self) -> tuple[int, int, int, int]:
+        """Sizes of the four action heads: distance, turn, fire, target slot."""
+        return len(self.distances), len(self.turns_deg), len(self.fire_powers), self.enemy_slots
+
+    @property
+    def n_actions(self) -> int:
+        """Joint actions."""
+        return int(np.prod(self.dims))
+
+    @property
+    def n_features(self) -> int:
+        """Tank view length."""
+        return n_features(self.enemy_slots, self.mate_slots)
+
+
+def action_table(space: TankSpace) -> np.ndarray:
+    """(n_actions, 4) rows of (distance, body turn, fire power (-1 = hold), target slot) per joint action."""
+    nd, nt, nf, nk = space.dims
+    a = np.arange(space.n_actions)
+    k, f = a % nk, (a // nk) % nf
+    t, d = (a // (nk * nf)) % nt, a // (nk * nf * nt)
+    power = np.asarray(space.fire_powers, dtype=np.float64)[f]
+    return np.stack([np.asarray(space.distances, dtype=np.float64)[d],
+                     np.radians(np.asarray(space.turns_deg, dtype=np.float64))[t],
+                     np.where(power > 0, power, -1.0), k.astype(np.float64)], axis=1)
+
+
+@njit(cache=True)
+def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, age: float, power: float,
+               width: float, height: float) -> tuple[float, float]:
+    """Where to aim at an enemy last scanned at (mx, my) heading mh at velocity mv ``age`` turns ago: linear
+    lead, the enemy keeps its heading and speed while our bullet of ``power`` flies (speed 20 - 3 p,
+    Rules.getBulletSpeed); clipped to where a robot's centre can be; 10 fixed-point iterations."""
+    speed = 20.0 - 3.0 * power
+    s, c = np.sin(mh), np.cos(mh)
+    px, py, t = mx, my, 0.0
+    for _ in range(10):
+        px = min(max(mx + s * mv * (age + t), WALL_MARGIN), width - WALL_MARGIN)
+        py = min(max(my + c * mv * (age + t), WALL_MARGIN), height - WALL_MARGIN)
+        t = np.hypot(px - x, py - y) / speed
+    return px, py
+
+
+@njit(cache=True)
+def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e: np.ndarray, heat: np.ndarray,
+                  alive: np.ndarray, team: np.ndarray, i: int, memory: np.ndarray, seen: np.ndarray, time: float,
+                  width: float, height: float, k_slots: int, m_slots: int, out: np.ndarray,
+                  slots: np.ndarray) -> None:
+    """Robot i's tank view of one battle's (R,) robots into ``out`` (F,), its enemy slots into ``slots`` (K,).
+
+    An enemy is known while alive and scanned this round (``seen[i, j] >= 0``), at ``memory[:, i, j]``
+    (MEMORY_ROWS, R, R); team-mates as they are. Slots are filled nearest first (ties: lower index)."""
+    n = x.shape[0]
+    diag = np.hypot(width, height)
+    for q in range(out.shape[0]):
+        out[q] = 0.0
+    for q in range(k_slots):
+        slots[q] = -1
+    out[0] = x[i] / width
+    out[1] = y[i] / height
+    out[2] = (width - x[i]) / width
+    out[3] = (height - y[i]) / height
+    out[4] = np.sin(h[i])
+    out[5] = np.cos(h[i])
+    out[6] = v[i] / 8.0
+    out[7] = e[i] / 100.0
+    out[8] = heat[i] / 3.0
+    n_en, n_en_alive, n_mate, n_mate_alive = 0, 0, 0, 0
+    for j in range(n):
+        if j == i:
+            continue
+        if team[j] == team[i]:
+            n_mate += 1
+            n_mate_alive += 1 if alive[j] else 0
+        else:
+            n_en += 1
+            n_en_alive += 1 if alive[j] else 0
+    out[9] = n_en_alive / n_en if n_en > 0 else 0.0
+    out[10] = n_mate_alive / n_mate if n_mate > 0 else 0.0
+    # enemies: selection by distance to the remembered position (k_slots smallest, ties to the lower index)
+    used = np.zeros(n, dtype=np.bool_)
+    for s in range(k_slots):
+        best, best_d = -1, np.inf
+        for j in range(n):
+            if used[j] or team[j] == team[i] or not alive[j] or seen[i, j] < 0:
+                continue
+            d = np.hypot(memory[M_X, i, j] - x[i], memory[M_Y, i, j] - y[i])
+            if d < best_d:
+                best, best_d = j, d
+        if best < 0:
+            break
+        used[best] = True
+        slots[s] = best
+        o = OWN_FEATURES + ENEMY_FEATURES * s
+        bearing = np.arctan2(memory[M_X, i, best] - x[i], memory[M_Y, i, best] - y[i])
+        rel = bearing - h[i]
+        rel_h = memory[M_H, i, best] - bearing
+        out[o] = 1.0
+        out[o + 1] = np.sin(rel)
+        out[o + 2] = np.cos(rel)
+        out[o + 3] = min(best_d / diag, 1.0)
+        out[o + 4] = memory[M_V, i, best] * np.sin(rel_h) / 8.0
+        out[o + 5] = memory[M_V, i, best] * np.cos(rel_h) / 8.0
+        out[o + 6] = memory[M_E, i, best] / 100.0
+        out[o + 7] = min(time - seen[i, best], MAX_AGE) / MAX_AGE
+        out[o + 8] = min(max(memory[M_DROP, i, best], 0.0), 3.0) / 3.0
+    # team-mates: as they are (team messages)
+    used[:] = False
+    for s in range(m_slots):
+        best, best_d = -1, np.inf
+        for j in range(n):
+            if used[j] or j == i or team[j] != team[i] or not alive[j]:
+                continue
+            d = np.hypot(x[j] - x[i], y[j] - y[i])
+            if d < best_d:
+                best, best_d = j, d
+        if best < 0:
+            break
+        used[best] = True
+        o = OWN_FEATURES + ENEMY_FEATURES * k_slots + MATE_FEATURES * s
+        rel = np.arctan2(x[best] - x[i], y[best] - y[i]) - h[i]
+        out[o] = 1.0
+        out[o + 1] = np.sin(rel)
+        out[o + 2] = np.cos(rel)
+        out[o + 3] = min(best_d / diag, 1.0)
+        out[o + 4] = e[best] / 100.0
+
+
+@njit(cache=True)
+def tank_view_kernel(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e: np.ndarray,
+                     heat: np.ndarray, alive: np.ndarray, team: np.ndarray, memory: np.ndarray, seen: np.ndarray,
+                     time: np.ndarray, width: float, height: float, k_slots: int, m_slots: int,
+                     feats: np.ndarray, slots: np.ndarray) -> None:
+    """Tank views (B, R, F) and enemy slot maps (B, R, K) of every robot of (B, R) arrays."""
+    row = np.zeros(feats.shape[2])
+    for b in range(x.shape[0]):
+        for i in range(x.shape[1]):
+            tank_view_row(x[b], y[b], h[b], v[b], e[b], heat[b], alive[b], team[b], i, memory[b], seen[b],
+                          float(time[b]), width, height, k_slots, m_slots, row, slots[b, i])
+            for q in range(row.shape[0]):
+                feats[b, i, q] = row[q]

@@ -112,7 +112,7 @@ def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: i
 
 @cli.command()
 @click.argument("experiment", type=click.Choice(["migration", "awm", "fuzzy", "transfer", "baselines", "all"]))
-@click.option("--seeds", type=int, default=None, help="Seeds per arm (default 10; migration 30).")
+@click.option("--seeds", type=int, default=None, help="Seeds per arm, at least 1 (default 10; migration alone 1000).")
 @click.option("--rounds", type=int, default=None, help="Rounds per arm (default from the config).")
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
 @click.option("--out", type=click.Path(path_type=Path), default=None, help="Output folder (default results/).")
@@ -165,8 +165,12 @@ def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: in
 @click.option("--name", default=None, help="Robot class name (default derived from the run).")
 def export(run: Path, out: Path, name: str | None) -> None:
     """Export a trained policy as a standalone Robocode robot (no Python needed to run it)."""
+    from confront.engine.tank_export import export_tank_cli, is_tank_run
     from confront.experiments.evaluate import export_cli
 
+    if is_tank_run(run):  # a PPO run over the tank view: confront.TankBot
+        export_tank_cli(run, out=out)
+        return
     export_cli(run, out=out, name=name)
 
 

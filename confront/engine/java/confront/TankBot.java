@@ -1,0 +1,175 @@
+package confront;
+
+import java.io.IOException;
+import java.io.InputStream;
+import java.io.InputStreamReader;
+import java.io.Reader;
+import java.io.StringReader;
+import java.nio.charset.StandardCharsets;
+import java.util.HashSet;
+import java.util.LinkedHashMap;
+import java.util.Map;
+import java.util.Set;
+
+import robocode.MessageEvent;
+import robocode.RobotDeathEvent;
+import robocode.RoundEndedEvent;
+import robocode.ScannedRobotEvent;
+import robocode.TeamRobot;
+
+/**
+ * A tank policy trained with confront (PPO over the tank view and tank actions), running with no Python.
+ * Its policy is compiled into confront.TankData at export. Every step_turns turns it builds the tank view
+ * (confront.arena.tank) from what it knows: its own getters, the last ScannedRobotEvent of each living enemy
+ * this round (position, energy, heading, velocity, the energy drop since the previous scan, the scan time)
+ * and the latest (x, y, energy) each living team-mate broadcast; it picks the greedy tank action (move,
+ * body turn, fire power or hold, target slot). Every turn the gun/radar controller aims at the chosen
+ * target (the nearest known enemy when that one is unknown or dead), leading it linearly.
+ *
+ * <p>Robocode makes a new robot object each round, so the memory starts empty every round. A team-mate's
+ * broadcast arrives one turn later, so mates are seen as they were a turn ago (and not at all at turn 0).
+ */
+public class TankBot extends TeamRobot {
+    /** name: {x, y, energy, heading, velocity, energy drop, scan time} of the last scan this round. */
+    private final Map<String, double[]> enemies = new LinkedHashMap<>();
+    /** name: {x, y, energy} of the latest message this round. */
+    private final Map<String, double[]> mates = new LinkedHashMap<>();
+    private final Set<String> deadMates = new HashSet<>();
+    private int decisions;
+    private int shots;
+
+    @Override
+    public void run() {
+        setAdjustGunForRobotTurn(true);
+        setAdjustRadarForRobotTurn(true);
+        setAdjustRadarForGunTurn(true);
+        RoundStart.awaitEngine();
+        TankModel model;
+        try {
+            model = load();
+        } catch (IOException | RuntimeException e) {
+            out.println("CONFRONT tank-load-failed " + e);
+            while (true) {
+                setTurnRadarRightRadians(2 * Math.PI);
+                execute();
+            }
+        }
+        String[] team = getTeammates();
+        int matesStart = team == null ? 0 : team.length;
+        int enemiesStart = Math.max(getOthers() - matesStart, 0);
+        int step = model.stepTurns();
+        int[] slots = new int[model.enemySlots];
+        String chosen = null;
+        double power = -1.0;
+        while (true) {
+            try {
+                broadcast();
+                String[] names = enemies.keySet().toArray(new String[0]);
+                double[][] known = enemies.values().toArray(new double[0][]);
+                double time = getTime();
+                if (getTime() % step == 0) {  // as PolicyBot: the commands set now take effect in turn getTime()+1
+                    int matesAlive = Math.max(matesStart - deadMates.size(), 0);
+                    double[] v = model.view(getX(), getY(), getHeadingRadians(), getVelocity(), getEnergy(),
+                            getGunHeat(), Math.max(getOthers() - matesAlive, 0), enemiesStart, matesAlive,
+                            matesStart, known, mates.values().toArray(new double[0][]), time,
+                            getBattleFieldWidth(), getBattleFieldHeight(), slots);
+                    double[] a = model.decode(model.act(v));
+                    setAhead(a[0]);
+                    setTurnRightRadians(a[1]);
+                    power = a[2];
+                    int k = (int) a[3];
+                    chosen = slots[k] >= 0 ? names[slots[k]] : null;
+                    decisions++;
+                }
+                int c = -1;
+                for (int j = 0; j < names.length; j++) {
+                    if (names[j].equals(chosen)) {
+                        c = j;
+                    }
+                }
+                int tgt = TankModel.target(getX(), getY(), known, c);
+                double[] g = model.control(getX(), getY(), getGunHeadingRadians(), getRadarHeadingRadians(),
+                        getGunHeat(), getEnergy(), known, tgt, power, time, getBattleFieldWidth(),
+                        getBattleFieldHeight());
+                if (!Double.isNaN(g[0])) {
+                    setTurnGunRightRadians(g[0]);
+                }
+                setTurnRadarRightRadians(g[1]);
+                if (g[2] > 0) {
+                    setFire(g[2]);
+                    shots++;
+                }
+            } catch (RuntimeException e) {
+                out.println("CONFRONT tank-error " + e);
+                throw e;
+            }
+            execute();
+        }
+    }
+
+    /** The policy compiled into confront.TankData (written at export), else tank_policy.txt beside the class. */
+    private TankModel load() throws IOException {
+        try {
+            String[] chunks = (String[]) Class.forName("confront.TankData").getField("CHUNKS").get(null);
+            return TankModel.read(new StringReader(String.join("", chunks)));
+        } catch (ReflectiveOperationException e) {
+            InputStream res = getClass().getResourceAsStream("tank_policy.txt");
+            if (res == null) {
+                throw new IOException("no confront.TankData class and no tank_policy.txt");
+            }
+            try (Reader r = new InputStreamReader(res, StandardCharsets.UTF_8)) {
+                return TankModel.read(r);
+            }
+        }
+    }
+
+    private void broadcast() {
+        if (getTeammates() == null) {
+            return;
+        }
+        try {
+            broadcastMessage(new double[] {getX(), getY(), getEnergy()});
+        } catch (IOException e) {
+            out.println("CONFRONT tank-error broadcast " + e);
+        }
+    }
+
+    @Override
+    public void onScannedRobot(ScannedRobotEvent e) {
+        String name = e.getName();
+        if (isTeammate(name)) {
+            return;
+        }
+        double abs = getHeadingRadians() + e.getBearingRadians();
+        double[] prev = enemies.get(name);
+        double drop = prev != null ? prev[2] - e.getEnergy() : 0.0;
+        enemies.put(name, new double[] {getX() + e.getDistance() * Math.sin(abs),
+                getY() + e.getDistance() * Math.cos(abs), e.getEnergy(), e.getHeadingRadians(), e.getVelocity(),
+                drop, e.getTime()});
+    }
+
+    @Override
+    public void onMessageReceived(MessageEvent e) {
+        String from = e.getSender();
+        Object m = e.getMessage();
+        if (from != null && isTeammate(from) && !deadMates.contains(from) && m instanceof double[]
+                && ((double[]) m).length == 3) {
+            mates.put(from, ((double[]) m).clone());
+        }
+    }
+
+    @Override
+    public void onRobotDeath(RobotDeathEvent e) {
+        String name = e.getName();
+        enemies.remove(name);
+        if (isTeammate(name)) {
+            mates.remove(name);
+            deadMates.add(name);
+        }
+    }
+
+    @Override
+    public void onRoundEnded(RoundEndedEvent e) {
+        out.println("CONFRONT tank-round decisions=" + decisions + " shots=" + shots);
+    }
+}

@@ -1,0 +1,397 @@
+package confront;
+
+import java.io.BufferedReader;
+import java.io.IOException;
+import java.io.Reader;
+import java.util.ArrayList;
+import java.util.HashMap;
+import java.util.List;
+import java.util.Map;
+
+/**
+ * An exported tank policy (no Robocode dependency): the tank view of confront.arena.tank.tank_view_row, the
+ * actor MLP (tanh hidden layers, linear logits), the greedy tank action (argmax per head) and the gun/radar
+ * controller of confront.arena.smdp.controller_turn with the linear lead of confront.arena.tank.lead_point.
+ * Mirrors confront.engine.tank_export.TankPolicy; the file format is written by its to_text().
+ *
+ * <p>Angles follow Robocode: radians, 0 = north (+y), clockwise. Enemy rows are {x, y, energy, heading,
+ * velocity, energy drop, scan time} of the last scan this round; mate rows are {x, y, energy}.
+ */
+public final class TankModel {
+    static final double TWO_PI = 2 * Math.PI;
+    static final int OWN = 11;
+    static final int ENEMY = 9;
+    static final int MATE = 5;
+    static final double MAX_AGE = 50.0;
+    static final double WALL_MARGIN = 18.0;
+
+    final Map<String, String> keys = new HashMap<>();
+    final List<double[][]> weights = new ArrayList<>();
+    final List<double[]> biases = new ArrayList<>();
+    double[] distances;
+    double[] turns;  // radians
+    double[] powers;  // fire powers as given (0 = hold)
+    int enemySlots;
+    int mateSlots;
+    int stepTurns;
+    boolean lead;
+    double overshoot;
+    double tolerance;
+    double powerNear;
+    double powerMid;
+    double powerFar;
+    double nearDistance;
+    double farDistance;
+    boolean fire;
+
+    /** Reads a "confront-tank 1" policy file. */
+    public static TankModel read(Reader source) throws IOException {
+        TankModel m = new TankModel();
+        BufferedReader r = new BufferedReader(source);
+        String first = r.readLine();
+        if (first == null || !first.equals("confront-tank 1")) {
+            throw new IOException("not a confront tank policy file (version 1): " + first);
+        }
+        String line;
+        while ((line = r.readLine()) != null) {
+            if (line.isEmpty() || line.startsWith("#")) {
+                continue;
+            }
+            String[] p = line.split(" ");
+            if (p[0].equals("matrix")) {
+                int rows = Integer.parseInt(p[2]);
+                int cols = Integer.parseInt(p[3]);
+                double[][] a = new double[rows][cols];
+                for (int i = 0; i < rows; i++) {
+                    String row = r.readLine();
+                    String[] v = row == null ? new String[0] : row.split(" ");
+                    if (v.length != cols) {
+                        throw new IOException("matrix " + p[1] + " row " + i + " has " + v.length + " values");
+                    }
+                    for (int j = 0; j < cols; j++) {
+                        a[i][j] = Double.parseDouble(v[j]);
+                    }
+                }
+                int layer = Integer.parseInt(p[1].substring(1));
+                if (p[1].startsWith("w") && layer == m.weights.size()) {
+                    m.weights.add(a);
+                } else if (p[1].startsWith("b") && layer == m.biases.size() && rows == 1) {
+                    m.biases.add(a[0]);
+                } else {
+                    throw new IOException("unexpected matrix " + p[1] + " " + rows + "x" + cols);
+                }
+            } else {
+                int sp = line.indexOf(' ');
+                m.keys.put(sp < 0 ? line : line.substring(0, sp), sp < 0 ? "" : line.substring(sp + 1));
+            }
+        }
+        m.distances = m.list("distances");
+        double[] deg = m.list("turns_deg");
+        m.turns = new double[deg.length];
+        for (int i = 0; i < deg.length; i++) {
+            m.turns[i] = Math.toRadians(deg[i]);
+        }
+        m.powers = m.list("fire_powers");
+        m.enemySlots = (int) m.num("enemy_slots");
+        m.mateSlots = (int) m.num("mate_slots");
+        m.stepTurns = (int) m.num("step_turns");
+        m.lead = "linear".equals(m.keys.get("lead"));
+        m.overshoot = m.num("radar_overshoot");
+        m.tolerance = m.num("aim_tolerance");
+        m.powerNear = m.num("power_near");
+        m.powerMid = m.num("power_mid");
+        m.powerFar = m.num("power_far");
+        m.nearDistance = m.num("near_distance");
+        m.farDistance = m.num("far_distance");
+        m.fire = m.num("fire") != 0;
+        m.check();
+        return m;
+    }
+
+    private void check() throws IOException {
+        if (weights.isEmpty() || weights.size() != biases.size()) {
+            throw new IOException("the actor needs matrices w0, b0, w1, b1, ... (got " + weights.size()
+                    + " weights, " + biases.size() + " biases)");
+        }
+        int in = nFeatures();
+        for (int l = 0; l < weights.size(); l++) {
+            double[][] w = weights.get(l);
+            if (w.length == 0 || w[0].length != in || biases.get(l).length != w.length) {
+                throw new IOException("layer " + l + " does not chain from " + in + " inputs");
+            }
+            in = w.length;
+        }
+        int[] d = dims();
+        if (in != d[0] + d[1] + d[2] + d[3]) {
+            throw new IOException("the actor outputs " + in + " logits, the heads need " + (d[0] + d[1] + d[2] + d[3]));
+        }
+    }
+
+    double num(String key) {
+        String v = keys.get(key);
+        if (v == null) {
+            throw new IllegalArgumentException("tank policy file lacks " + key);
+        }
+        return Double.parseDouble(v.trim());
+    }
+
+    double[] list(String key) {
+        String v = keys.get(key);
+        if (v == null || v.trim().isEmpty()) {
+            throw new IllegalArgumentException("tank policy file lacks " + key);
+        }
+        String[] p = v.trim().split(" ");
+        double[] a = new double[p.length];
+        for (int i = 0; i < p.length; i++) {
+            a[i] = Double.parseDouble(p[i]);
+        }
+        return a;
+    }
+
+    public int stepTurns() {
+        return stepTurns;
+    }
+
+    /** Tank view length: 11 + 9 K + 5 M. */
+    public int nFeatures() {
+        return OWN + ENEMY * enemySlots + MATE * mateSlots;
+    }
+
+    /** Sizes of the four heads: distance, turn, fire power, enemy slot. */
+    public int[] dims() {
+        return new int[] {distances.length, turns.length, powers.length, enemySlots};
+    }
+
+    /**
+     * The tank view (tank_view_row, in double precision). enemies: the enemies known (alive, scanned this
+     * round), rows {x, y, energy, heading, velocity, drop, scan time}; mates: living team-mates {x, y, energy}.
+     * Slots are filled nearest first, ties to the lower row; slots[k] gets the enemy row of slot k (-1 empty).
+     */
+    public double[] view(double x, double y, double heading, double velocity, double energy, double gunHeat,
+                         int enemiesAlive, int enemiesStart, int matesAlive, int matesStart, double[][] enemies,
+                         double[][] mates, double time, double width, double height, int[] slots) {
+        double[] out = new double[nFeatures()];
+        double diag = Math.hypot(width, height);
+        out[0] = x / width;
+        out[1] = y / height;
+        out[2] = (width - x) / width;
+        out[3] = (height - y) / height;
+        out[4] = Math.sin(heading);
+        out[5] = Math.cos(heading);
+        out[6] = velocity / 8.0;
+        out[7] = energy / 100.0;
+        out[8] = gunHeat / 3.0;
+        out[9] = enemiesStart > 0 ? (double) enemiesAlive / enemiesStart : 0.0;
+        out[10] = matesStart > 0 ? (double) matesAlive / matesStart : 0.0;
+        for (int s = 0; s < slots.length; s++) {
+            slots[s] = -1;
+        }
+        boolean[] used = new boolean[enemies.length];
+        for (int s = 0; s < enemySlots; s++) {
+            int best = -1;
+            double bestD = Double.POSITIVE_INFINITY;
+            for (int j = 0; j < enemies.length; j++) {
+                if (used[j]) {
+                    continue;
+                }
+                double d = Math.hypot(enemies[j][0] - x, enemies[j][1] - y);
+                if (d < bestD) {
+                    best = j;
+                    bestD = d;
+                }
+            }
+            if (best < 0) {
+                break;
+            }
+            used[best] = true;
+            if (s < slots.length) {
+                slots[s] = best;
+            }
+            double[] e = enemies[best];
+            int o = OWN + ENEMY * s;
+            double bearing = Math.atan2(e[0] - x, e[1] - y);
+            double rel = bearing - heading;
+            double relH = e[3] - bearing;
+            out[o] = 1.0;
+            out[o + 1] = Math.sin(rel);
+            out[o + 2] = Math.cos(rel);
+            out[o + 3] = Math.min(bestD / diag, 1.0);
+            out[o + 4] = e[4] * Math.sin(relH) / 8.0;
+            out[o + 5] = e[4] * Math.cos(relH) / 8.0;
+            out[o + 6] = e[2] / 100.0;
+            out[o + 7] = Math.min(time - e[6], MAX_AGE) / MAX_AGE;
+            out[o + 8] = Math.min(Math.max(e[5], 0.0), 3.0) / 3.0;
+        }
+        used = new boolean[mates.length];
+        for (int s = 0; s < mateSlots; s++) {
+            int best = -1;
+            double bestD = Double.POSITIVE_INFINITY;
+            for (int j = 0; j < mates.length; j++) {
+                if (used[j]) {
+                    continue;
+                }
+                double d = Math.hypot(mates[j][0] - x, mates[j][1] - y);
+                if (d < bestD) {
+                    best = j;
+                    bestD = d;
+                }
+            }
+            if (best < 0) {
+                break;
+            }
+            used[best] = true;
+            int o = OWN + ENEMY * enemySlots + MATE * s;
+            double rel = Math.atan2(mates[best][0] - x, mates[best][1] - y) - heading;
+            out[o] = 1.0;
+            out[o + 1] = Math.sin(rel);
+            out[o + 2] = Math.cos(rel);
+            out[o + 3] = Math.min(bestD / diag, 1.0);
+            out[o + 4] = mates[best][2] / 100.0;
+        }
+        return out;
+    }
+
+    /** Actor logits for a view; the view is rounded to float32 first, as the simulator hands it to the learner. */
+    public double[] logits(double[] view) {
+        double[] h = new double[view.length];
+        for (int i = 0; i < view.length; i++) {
+            h[i] = (float) view[i];
+        }
+        for (int l = 0; l < weights.size(); l++) {
+            double[][] w = weights.get(l);
+            double[] b = biases.get(l);
+            double[] o = new double[w.length];
+            boolean last = l == weights.size() - 1;
+            for (int i = 0; i < w.length; i++) {
+                double s = b[i];
+                for (int j = 0; j < h.length; j++) {
+                    s += w[i][j] * h[j];
+                }
+                o[i] = last ? s : Math.tanh(s);
+            }
+            h = o;
+        }
+        return h;
+    }
+
+    /** Greedy joint action ((d * nt + t) * nf + f) * K + k: the first maximum of each head's logits. */
+    public int act(double[] view) {
+        double[] z = logits(view);
+        int[] d = dims();
+        int joint = 0;
+        int off = 0;
+        for (int head = 0; head < 4; head++) {
+            int best = 0;
+            for (int i = 1; i < d[head]; i++) {
+                if (z[off + i] > z[off + best]) {
+                    best = i;
+                }
+            }
+            joint = joint * d[head] + best;
+            off += d[head];
+        }
+        return joint;
+    }
+
+    /** (distance, body turn rad, fire power (-1 = hold), enemy slot) of a joint action (action_table). */
+    public double[] decode(int action) {
+        int[] d = dims();
+        int k = action % d[3];
+        int f = (action / d[3]) % d[2];
+        int t = (action / (d[3] * d[2])) % d[1];
+        int dist = action / (d[3] * d[2] * d[1]);
+        double p = powers[f];
+        return new double[] {distances[dist], turns[t], p > 0 ? p : -1.0, k};
+    }
+
+    /**
+     * Linear lead (lead_point): where an enemy scanned at (mx, my) heading mh at velocity mv age turns ago is
+     * when a bullet of the power reaches it; clipped to where a robot's centre can be; 10 iterations.
+     */
+    public static double[] leadPoint(double x, double y, double mx, double my, double mh, double mv, double age,
+                                     double power, double width, double height) {
+        double speed = 20.0 - 3.0 * power;
+        double s = Math.sin(mh);
+        double c = Math.cos(mh);
+        double px = mx;
+        double py = my;
+        double t = 0.0;
+        for (int i = 0; i < 10; i++) {
+            px = Math.min(Math.max(mx + s * mv * (age + t), WALL_MARGIN), width - WALL_MARGIN);
+            py = Math.min(Math.max(my + c * mv * (age + t), WALL_MARGIN), height - WALL_MARGIN);
+            t = Math.hypot(px - x, py - y) / speed;
+        }
+        return new double[] {px, py};
+    }
+
+    /** The row to aim at: chosen when it is a known enemy (>= 0), else the nearest known (first of equals), -1. */
+    public static int target(double x, double y, double[][] enemies, int chosen) {
+        if (chosen >= 0 && chosen < enemies.length) {
+            return chosen;
+        }
+        int best = -1;
+        double bestD = Double.POSITIVE_INFINITY;
+        for (int j = 0; j < enemies.length; j++) {
+            double dx = enemies[j][0] - x;
+            double dy = enemies[j][1] - y;
+            double d = dx * dx + dy * dy;
+            if (d < bestD) {
+                best = j;
+                bestD = d;
+            }
+        }
+        return best;
+    }
+
+    /** Angle wrapped to [-pi, pi) as (a + pi) mod 2 pi - pi (numpy's float mod). */
+    static double relAngle(double a) {
+        double s = a + Math.PI;
+        double r = s % TWO_PI;  // fmod, as observe.float_mod
+        if (r < 0) {
+            r += TWO_PI;
+        }
+        return r - Math.PI;
+    }
+
+    /**
+     * (gun turn, radar turn, fire power) of the controller (controller_turn) toward enemies[tgt] (tgt -1: none:
+     * NaN = keep the gun, a full radar turn, no fire), with the linear lead when the policy has one. power:
+     * the step's chosen power (-1 = hold, 0 = by distance band).
+     */
+    public double[] control(double x, double y, double gunHeading, double radarHeading, double gunHeat,
+                            double energy, double[][] enemies, int tgt, double power, double time, double width,
+                            double height) {
+        if (tgt < 0) {
+            return new double[] {Double.NaN, TWO_PI, 0.0};
+        }
+        double[] e = enemies[tgt];
+        double tx = e[0];
+        double ty = e[1];
+        if (lead) {
+            double[] p = leadPoint(x, y, tx, ty, e[3], e[4], time - e[6], power > 0 ? power : 2.0, width, height);
+            tx = p[0];
+            ty = p[1];
+        }
+        double dx = tx - x;
+        double dy = ty - y;
+        double bearing = Math.atan2(dx, dy);
+        double dist = Math.hypot(dx, dy);
+        double gun = relAngle(bearing - gunHeading);
+        double radar = relAngle(bearing - radarHeading);
+        radar = radar + Math.signum(radar) * overshoot;
+        boolean shoot = Math.abs(gun) <= tolerance && gunHeat == 0 && energy > 0 && fire;
+        double p;
+        if (!shoot || power < 0) {
+            p = 0.0;
+        } else if (power > 0) {
+            p = power;
+        } else if (dist < nearDistance) {
+            p = powerNear;
+        } else if (dist < farDistance) {
+            p = powerMid;
+        } else {
+            p = powerFar;
+        }
+        return new double[] {gun, radar, p};
+    }
+}

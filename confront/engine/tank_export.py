@@ -1,0 +1,296 @@
+"""Exporting a tank policy (an actor over the tank view and tank actions, :mod:`confront.arena.tank`) as the
+standalone Robocode robot ``confront.TankBot``, with its Java inference (``TankModel.java``).
+:class:`TankPolicy` is the Python twin: the same view (the simulator's ``tank_view_row``, fed what the robot
+knows), the same greedy action and the same gun/radar controller (``smdp.controller_turn`` with
+``tank.lead_point``).
+
+Policy file (text, data only): ``confront-tank 1``, ``key value`` lines (lists as space-separated values)
+and ``matrix NAME ROWS COLS`` blocks: ``w0 b0 w1 b1 ...``, weights as (out, in), tanh between layers, the
+last layer's outputs the logits of the four heads (distance, body turn, fire power, enemy slot) in order.
+
+A run trained on the tank view is exported when its ``model/model.json`` has ``"kind": "ppo"``: the actor
+is ``model/actor.npz`` (``w0, b0, w1, b1, ...`` as (out, in), or a torch state dict's
+``actor.<i>.weight`` / ``actor.<i>.bias``) and ``model/tank.json`` holds the TankSpace fields (top level or
+under ``"tank"``), ``step_turns`` (or ``turns_per_step``) and the ControlConfig values (top level or under
+``"control"``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from confront.arena.control import ControlConfig
+from confront.arena.observe import float_mod
+from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
+from confront.engine.export import policy_data_source
+from confront.engine.install import EngineInstall, find_engine
+from confront.engine.java_build import compile_java
+
+__all__ = ["TankPolicy", "robot_view", "robot_target", "robot_control", "export_tank_robot", "is_tank_run",
+           "load_tank_policy", "TANK_CLASSES"]
+
+TANK_CLASSES = ("TankBot", "TankModel", "RoundStart")
+EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time
+MateRow = Sequence[float]  # x, y, energy
+
+
+def robot_view(own: Sequence[float], counts: Sequence[int], enemies: Sequence[EnemyRow], mates: Sequence[MateRow],
+               time: float, width: float, height: float, space: TankSpace) -> tuple[np.ndarray, np.ndarray]:
+    """The tank view (float64, (F,)) and enemy slots ((K,), rows of ``enemies``, -1 empty) of one robot, from
+    what TankBot knows: ``own`` = (x, y, heading, velocity, energy, gun heat), ``counts`` = (enemies alive,
+    enemies at the start, mates alive, mates at the start), the known enemies' rows and the mates' rows.
+    Computed by the simulator's ``tank_view_row`` (self = robot 0, then the enemies, then the mates)."""
+    ne, nm = len(enemies), len(mates)
+    n = 1 + ne + nm
+    x, y, h, v, e, heat = (np.zeros(n) for _ in range(6))
+    x[0], y[0], h[0], v[0], e[0], heat[0] = own
+    team = np.array([0] + [1] * ne + [0] * nm, dtype=np.int64)
+    memory = np.zeros((MEMORY_ROWS, n, n))
+    seen = np.full((n, n), -1, dtype=np.int64)
+    for j, row in enumerate(enemies, start=1):
+        x[j], y[j], e[j] = row[0], row[1], row[2]
+        for r in range(6):
+            memory[r, 0, j] = row[r]
+        memory[6, 0, j] = 1.0
+        seen[0, j] = int(row[6])
+    for j, row in enumerate(mates, start=1 + ne):
+        x[j], y[j], e[j] = row
+    out = np.zeros(space.n_features)
+    slots = np.full(space.enemy_slots, -1, dtype=np.int64)
+    tank_view_row(x, y, h, v, e, heat, np.ones(n, dtype=np.bool_), team, 0, memory, seen, float(time),
+                  float(width), float(height), space.enemy_slots, space.mate_slots, out, slots)
+    ea, es, ma, ms = counts  # the counts TankBot has (its mates' messages may be missing at turn 0)
+    out[9] = ea / es if es > 0 else 0.0
+    out[10] = ma / ms if ms > 0 else 0.0
+    return out, np.where(slots >= 0, slots - 1, -1)
+
+
+def robot_target(x: float, y: float, enemies: Sequence[EnemyRow], chosen: int) -> int:
+    """Row to aim at: ``chosen`` when it is a known enemy, else the nearest (squared distance, first of
+    equals; observe.target_of), -1 without enemies."""
+    if 0 <= chosen < len(enemies):
+        return chosen
+    best, best_d = -1, math.inf
+    for j, row in enumerate(enemies):
+        d = (row[0] - x) * (row[0] - x) + (row[1] - y) * (row[1] - y)
+        if d < best_d:
+            best, best_d = j, d
+    return best
+
+
+def _relative(a: float) -> float:
+    """Angle wrapped to [-pi, pi) (smdp._relative)."""
+    return float(float_mod(a + math.pi, 2 * math.pi)) - math.pi
+
+
+def robot_control(control: ControlConfig, lead: bool, x: float, y: float, gun_heading: float, radar_heading: float,
+                  gun_heat: float, energy: float, enemies: Sequence[EnemyRow], target: int, power: float,
+                  time: float, width: float, height: float) -> tuple[float, float, float]:
+    """(gun turn (NaN = keep), radar turn, fire power) of the controller (smdp.controller_turn) toward
+    ``enemies[target]`` with the linear lead (``lead_point``, bullet power ``power`` or 2 when not set);
+    ``power`` -1 holds fire, 0 picks it by distance band."""
+    if target < 0:
+        return math.nan, 2 * math.pi, 0.0
+    row = enemies[target]
+    tx, ty = float(row[0]), float(row[1])
+    if lead:
+        tx, ty = lead_point(x, y, tx, ty, float(row[3]), float(row[4]), float(time - row[6]),
+                            power if power > 0 else 2.0, float(width), float(height))
+    dx, dy = tx - x, ty - y
+    bearing = math.atan2(dx, dy)
+    dist = math.hypot(dx, dy)
+    gun = _relative(bearing - gun_heading)
+    radar = _relative(bearing - radar_heading)
+    radar = radar + float(np.sign(radar)) * control.radar_overshoot
+    shoot = abs(gun) <= control.aim_tolerance and gun_heat == 0 and energy > 0 and control.fire
+    if not shoot or power < 0:
+        p = 0.0
+    elif power > 0:
+        p = power
+    elif dist < control.near_distance:
+        p = control.power_near
+    elif dist < control.far_distance:
+        p = control.power_mid
+    else:
+        p = control.power_far
+    return gun, radar, float(p)
+
+
+@dataclass(frozen=True)
+class TankPolicy:
+    """A greedy tank policy: the actor MLP (weights (out, in), tanh hidden layers, linear logits) over the
+    tank view, its TankSpace, the controller's settings and the step length in turns."""
+
+    weights: tuple[np.ndarray, ...]
+    biases: tuple[np.ndarray, ...]
+    space: TankSpace = field(default_factory=TankSpace)
+    control: ControlConfig = field(default_factory=ControlConfig)
+    step_turns: int = 5
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.step_turns, int) or self.step_turns < 1:
+            raise ValueError(f"step_turns must be an integer >= 1, got {self.step_turns!r}")
+        if not self.weights or len(self.weights) != len(self.biases):
+            raise ValueError("the actor needs as many weight matrices as bias vectors (at least one)")
+        n_in = self.space.n_features
+        for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+            if w.ndim != 2 or w.shape[1] != n_in or b.shape != (w.shape[0],):
+                raise ValueError(f"layer {i}: weights {w.shape} / bias {b.shape} do not chain from {n_in}")
+            if not (np.all(np.isfinite(w)) and np.all(np.isfinite(b))):
+                raise ValueError(f"layer {i} has non-finite values")
+            n_in = w.shape[0]
+        if n_in != sum(self.space.dims):
+            raise ValueError(f"the actor outputs {n_in} logits, the heads {self.space.dims} need "
+                             f"{sum(self.space.dims)}")
+
+    @classmethod
+    def from_state(cls, state: Mapping[str, np.ndarray], space: TankSpace | None = None,
+                   control: ControlConfig | None = None, step_turns: int = 5) -> TankPolicy:
+        """From the actor's arrays: ``w0, b0, w1, b1, ...`` (weights (out, in)), or a torch state dict's linear
+        layers ``actor.<i>.weight`` / ``actor.<i>.bias`` (in the order of i)."""
+        if "w0" in state:
+            n = sum(1 for k in state if re.fullmatch(r"w\d+", k))
+            names = [(f"w{i}", f"b{i}") for i in range(n)]
+        else:
+            idx = sorted(int(m.group(1)) for k in state if (m := re.fullmatch(r"actor\.(\d+)\.weight", k)))
+            if not idx:
+                raise ValueError(f"no actor weights (w0 or actor.<i>.weight) among {sorted(state)}")
+            names = [(f"actor.{i}.weight", f"actor.{i}.bias") for i in idx]
+        missing = [k for pair in names for k in pair if k not in state]
+        if missing:
+            raise ValueError(f"actor arrays missing: {missing}")
+        return cls(tuple(np.asarray(state[w], dtype=np.float64) for w, _ in names),
+                   tuple(np.asarray(state[b], dtype=np.float64).reshape(-1) for _, b in names),
+                   space or TankSpace(), control or ControlConfig(), step_turns)
+
+    # -- decisions -------------------------------------------------------------------------------
+    def logits(self, view: np.ndarray) -> np.ndarray:
+        """The actor's logits for one view (rounded to float32 first, as the simulator hands it over)."""
+        h = np.asarray(view, dtype=np.float32).astype(np.float64)
+        for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+            h = w @ h + b
+            if i < len(self.weights) - 1:
+                h = np.tanh(h)
+        return h
+
+    def act(self, view: np.ndarray) -> int:
+        """Greedy joint action ``((d * nt + t) * nf + f) * K + k``: the first maximum of each head."""
+        z = self.logits(view)
+        joint, off = 0, 0
+        for n in self.space.dims:
+            joint = joint * n + int(np.argmax(z[off:off + n]))
+            off += n
+        return joint
+
+    def decode(self, action: int) -> tuple[float, float, float, int]:
+        """(distance, body turn rad, fire power (-1 = hold), enemy slot) of a joint action (action_table)."""
+        d, t, p, k = action_table(self.space)[action]
+        return float(d), float(t), float(p), int(k)
+
+    # -- file ----------------------------------------------------------------------------------
+    def to_text(self) -> str:
+        """The policy file read by TankModel.java."""
+        s = self.space
+
+        def nums(v: Sequence[float]) -> str:
+            return " ".join(repr(float(x)) for x in v)
+
+        lines = ["confront-tank 1", f"step_turns {self.step_turns}", f"distances {nums(s.distances)}",
+                 f"turns_deg {nums(s.turns_deg)}", f"fire_powers {nums(s.fire_powers)}",
+                 f"enemy_slots {s.enemy_slots}", f"mate_slots {s.mate_slots}", f"lead {s.lead}"]
+        for f in fields(ControlConfig):
+            v = getattr(self.control, f.name)
+            lines.append(f"{f.name} {int(v) if isinstance(v, bool) else repr(float(v))}")
+        for i, (w, b) in enumerate(zip(self.weights, self.biases, strict=True)):
+            for name, a in ((f"w{i}", w), (f"b{i}", b[None, :])):
+                lines.append(f"matrix {name} {a.shape[0]} {a.shape[1]}")
+                lines.extend(" ".join(repr(float(v)) for v in row) for row in a)
+        return "\n".join(lines) + "\n"
+
+
+def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstall | None = None) -> Path:
+    """Write the standalone robot ``confront.TankBot`` with ``policy``: a robots folder or a ``.jar``.
+
+    It holds ``confront/TankBot.class``, ``TankModel.class``, ``RoundStart.class``, ``TankData.class`` (the
+    policy as string constants, so the robot reads no file), ``TankBot.properties``, ``tank_policy.txt``
+    and the Java sources."""
+    install = install or find_engine()
+    classes = compile_java(install)
+    out = Path(out)
+    with tempfile.TemporaryDirectory(prefix="confront-tank-export-") as tmp:
+        root = Path(tmp) / "robot" if out.suffix == ".jar" else out
+        pkg = root / "confront"
+        pkg.mkdir(parents=True, exist_ok=True)
+        src = Path(__file__).parent / "java" / "confront"
+        for cls in TANK_CLASSES:
+            shutil.copy2(classes / "confront" / f"{cls}.class", pkg / f"{cls}.class")
+            shutil.copy2(src / f"{cls}.java", pkg / f"{cls}.java")
+        (pkg / "TankBot.properties").write_text(
+            "robot.classname=confront.TankBot\nrobot.name=TankBot\nrobot.version=1.0\n"
+            "robot.description=A tank policy trained with confront (PPO), exported with its own inference\n"
+            "robot.java.source.included=true\nrobocode.version=1.9.3.9\n"
+        )
+        text = policy.to_text()
+        (pkg / "tank_policy.txt").write_text(text)
+        (pkg / "TankData.java").write_text(policy_data_source(text, name="TankData"))
+        proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),
+                               str(pkg / "TankData.java")], capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
+        if out.suffix == ".jar":
+            jar = shutil.which("jar") or str(Path(install.javac).with_name("jar"))
+            out.parent.mkdir(parents=True, exist_ok=True)
+            subprocess.run([jar, "cf", str(out.resolve()), "-C", str(root), "."], check=True,
+                           capture_output=True)
+    return out
+
+
+def _model_dir(run: str | Path) -> Path:
+    p = Path(run)
+    return p / "model" if (p / "model").is_dir() else p
+
+
+def is_tank_run(run: str | Path) -> bool:
+    """True when the run's (or model folder's) ``model.json`` says ``"kind": "ppo"``."""
+    try:
+        info = json.loads((_model_dir(run) / "model.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(info, dict) and info.get("kind") == "ppo"
+
+
+def load_tank_policy(run: str | Path) -> TankPolicy:
+    """The greedy policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``."""
+    folder = _model_dir(run)
+    cfg = json.loads((folder / "tank.json").read_text(encoding="utf-8"))
+    tank_cfg = cfg.get("tank", cfg)
+    names = {f.name for f in fields(TankSpace)}
+    space = TankSpace(**{k: tuple(v) if isinstance(v, list) else v for k, v in tank_cfg.items() if k in names})
+    ctl_cfg = cfg.get("control", cfg)
+    control = ControlConfig(**{f.name: ctl_cfg[f.name] for f in fields(ControlConfig) if f.name in ctl_cfg})
+    step = cfg.get("step_turns", cfg.get("turns_per_step"))
+    if step is None:
+        raise ValueError(f"{folder / 'tank.json'} lacks step_turns")
+    with np.load(folder / "actor.npz", allow_pickle=False) as z:
+        state = {k: z[k] for k in z.files}
+    return TankPolicy.from_state(state, space, control, int(step))
+
+
+def export_tank_cli(run: str | Path, out: str | Path) -> Path:
+    """``confront export`` for a PPO run: write confront.TankBot and say where."""
+    import click
+
+    path = export_tank_robot(load_tank_policy(run), out)
+    click.echo(f"wrote the robot confront.TankBot to {path}: copy it into Robocode's robots folder "
+               "(no Python needed to run it)")
+    return path

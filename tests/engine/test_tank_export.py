@@ -1,0 +1,288 @@
+"""The exported tank robot: its Java view, greedy action and controller equal the Python twin's, the twin's
+equal the simulator's on recorded battles, and the exported robot plays in the real engine."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from confront.arena.control import ControlConfig
+from confront.arena.smdp import SMDPConfig, TeamBattleEnv
+from confront.arena.tank import TankSpace
+from confront.engine.java_build import compile_java
+from confront.engine.tank_export import (
+    TankPolicy,
+    export_tank_robot,
+    is_tank_run,
+    load_tank_policy,
+    robot_control,
+    robot_target,
+    robot_view,
+)
+
+SPACE = TankSpace()
+FIELD = (800.0, 600.0)
+
+
+def _env(turns: int, seed: int) -> TeamBattleEnv:
+    return TeamBattleEnv("4v4", n_battles=2, seed=seed, opponents="SpinBot",
+                         config=SMDPConfig(turns_per_step=turns, tank=SPACE, reward="score"))
+
+
+def _knowledge(env: TeamBattleEnv, b: int, i: int) -> dict:
+    """What robot i of battle b knows, as TankBot holds it: own state, counts, known enemies (robot order)
+    from its scan memory, living mates as they are."""
+    s, team = env.arena.state, env.team_ids()
+    r = len(team)
+    enemies = [j for j in range(r) if team[j] != team[i] and s.alive[b, j] and s.scan_time[b, i, j] >= 0]
+    mates = [j for j in range(r) if j != i and team[j] == team[i] and s.alive[b, j]]
+    return {
+        "own": [float(v) for v in (s.x[b, i], s.y[b, i], s.heading[b, i], s.velocity[b, i], s.energy[b, i],
+                                   s.gun_heat[b, i])],
+        "guns": [float(s.gun_heading[b, i]), float(s.radar_heading[b, i])],
+        "counts": [int(sum(s.alive[b, j] for j in range(r) if team[j] != team[i])), int(sum(team != team[i])),
+                   len(mates), int(sum(team == team[i]) - 1)],
+        "ids": enemies,
+        "enemies": [[*(float(v) for v in env._memory[b, :6, i, j]), float(s.scan_time[b, i, j])] for j in enemies],
+        "mates": [[float(s.x[b, j]), float(s.y[b, j]), float(s.energy[b, j])] for j in mates],
+        "time": float(s.time[b]),
+    }
+
+
+@pytest.fixture(scope="module")
+def views() -> list[tuple[dict, np.ndarray, np.ndarray]]:
+    """(knowledge, the simulator's tank view (float32), its enemy slots as robot ids) of every living robot at
+    every decision of two 4v4 battles against SpinBot teams with random tank actions (T = 5)."""
+    env = _env(5, seed=11)
+    _, feats = env.reset()
+    rng = np.random.default_rng(12)
+    out = []
+    for step in range(140):
+        alive = env.arena.state.alive
+        for b in range(2):
+            for i in range(8):
+                if alive[b, i]:
+                    out.append((_knowledge(env, b, i), feats[b, i].copy(), env.slots[b, i].copy()))
+        if step < 139:
+            feats = env.step(rng.integers(0, env.n_actions, size=(2, 8))).features
+    return out
+
+
+@pytest.fixture(scope="module")
+def controls() -> list[tuple[dict, float, int, tuple[float, float, float]]]:
+    """(knowledge, step's fire power, chosen enemy row (-1 none), the simulator's (gun, radar, fire)) of every
+    living learning tank in turns of 4v4 battles with random tank actions held for one turn (T = 1)."""
+    env = _env(1, seed=21)
+    env.reset()
+    rng = np.random.default_rng(22)
+    out = []
+    for _ in range(300):
+        a = rng.integers(0, env.n_actions, size=(2, 8))
+        s = env.arena.state
+        before = [(b, i, _knowledge(env, b, i), env.slots[b, i].copy()) for b in range(2) for i in range(4)
+                  if s.alive[b, i] and not s.done[b]]
+        env.step(a)
+        for b, i, k, slots in before:
+            _, _, power, slot = (float(v) for v in _table()[a[b, i]])
+            robot = slots[int(slot)]
+            chosen = k["ids"].index(robot) if robot >= 0 and robot in k["ids"] else -1
+            out.append((k, power, chosen, tuple(float(v) for v in env._cmd[b, i, 2:5])))
+    return out
+
+
+def _table() -> np.ndarray:
+    from confront.arena.tank import action_table
+
+    return action_table(SPACE)
+
+
+def _policy(seed: int, hidden: int = 24, space: TankSpace = SPACE) -> TankPolicy:
+    rng = np.random.default_rng(seed)
+    sizes = [space.n_features, hidden, hidden, sum(space.dims)]
+    return TankPolicy(tuple(rng.normal(0, 1.0, size=(o, i)) for i, o in zip(sizes, sizes[1:], strict=False)),
+                      tuple(rng.normal(0, 0.5, size=o) for o in sizes[1:]), space, ControlConfig(), 5)
+
+
+# -- the Python twin against the simulator --------------------------------------------------------------
+
+
+def test_twin_view_equals_the_simulator(views) -> None:
+    covered = {"none": 0, "full": 0, "stale": 0, "drop": 0, "mates": 0, "dead": 0}
+    for k, feats, slots in views:
+        v, sl = robot_view(k["own"], k["counts"], k["enemies"], k["mates"], k["time"], *FIELD, SPACE)
+        np.testing.assert_array_equal(v.astype(np.float32), feats)
+        assert [k["ids"][j] if j >= 0 else -1 for j in sl] == list(slots)
+        covered["none"] += not k["enemies"]
+        covered["full"] += len(k["enemies"]) == 4
+        covered["stale"] += any(e[6] < k["time"] for e in k["enemies"])
+        covered["drop"] += any(e[5] > 0 for e in k["enemies"])
+        covered["mates"] += len(k["mates"]) > 0
+        covered["dead"] += k["counts"][0] < k["counts"][1] or k["counts"][2] < k["counts"][3]
+    assert all(n > 0 for n in covered.values()), covered
+
+
+def test_twin_controller_equals_the_simulator(controls) -> None:
+    shots = led = none = held = chosen = 0
+    for k, power, c, (gun, radar, fire) in controls:
+        x, y = k["own"][:2]
+        tgt = robot_target(x, y, k["enemies"], c)
+        g, r, f = robot_control(ControlConfig(), SPACE.lead == "linear", x, y, *k["guns"], k["own"][5], k["own"][4],
+                                k["enemies"], tgt, power, k["time"], *FIELD)
+        assert (math.isnan(g) and math.isnan(gun)) or g == pytest.approx(gun, abs=1e-12), k
+        assert r == pytest.approx(radar, abs=1e-12) and f == fire, k
+        shots += fire > 0
+        none += tgt < 0
+        held += power < 0 and tgt >= 0
+        chosen += c >= 0 and c != robot_target(x, y, k["enemies"], -1)
+        led += tgt >= 0 and k["enemies"][tgt][4] != 0
+    assert min(shots, led, none, held, chosen) > 0, (shots, led, none, held, chosen)
+
+
+# -- Java against the twin ----------------------------------------------------------------------------
+
+
+def _java(install, policy: TankPolicy, requests: list[str], tmp_path: Path) -> list[str]:
+    classes = compile_java(install)
+    pfile = tmp_path / "tank_policy.txt"
+    pfile.write_text(policy.to_text())
+    proc = subprocess.run([install.java, "-cp", str(classes), "confront.TankCheck", str(pfile)],
+                          input="\n".join(requests) + "\n", capture_output=True, text=True, check=True, timeout=60)
+    out = proc.stdout.splitlines()
+    assert len(out) == len(requests)
+    return out
+
+
+def _nums(v) -> str:
+    return " ".join(repr(float(x)) for x in v)
+
+
+def _rows(rows) -> str:
+    return "|".join(_nums(r) for r in rows)
+
+
+@pytest.mark.engine
+def test_java_view_equals_python(install, views, tmp_path) -> None:
+    reqs = [f"V\t{_nums(k['own'] + k['counts'] + [k['time'], *FIELD])}\t{_rows(k['enemies'])}\t{_rows(k['mates'])}"
+            for k, _, _ in views]
+    worst = 0.0
+    for line, (k, feats, _) in zip(_java(install, _policy(0), reqs, tmp_path), views, strict=True):
+        vals, slots = line.split("|")
+        jv = np.array([float(x) for x in vals.split()])
+        v, sl = robot_view(k["own"], k["counts"], k["enemies"], k["mates"], k["time"], *FIELD, SPACE)
+        worst = max(worst, float(np.abs(jv - v).max()), float(np.abs(jv.astype(np.float32) - feats).max()))
+        assert [int(s) for s in slots.split()] == list(sl)
+    assert worst <= 1e-9, worst
+
+
+@pytest.mark.engine
+def test_java_greedy_actions_equal_python(install, views, tmp_path) -> None:
+    rng = np.random.default_rng(3)
+    inputs = [f for _, f, _ in views] + [rng.uniform(-1, 1, SPACE.n_features) for _ in range(200)]
+    for seed in (1, 2):
+        policy = _policy(seed)
+        out = _java(install, policy, [f"A\t{_nums(v)}" for v in inputs], tmp_path)
+        heads = set()
+        for line, v in zip(out, inputs, strict=True):
+            a, logits = line.split("|")
+            np.testing.assert_allclose([float(z) for z in logits.split()], policy.logits(v), rtol=0, atol=1e-9)
+            assert int(a) == policy.act(v)
+            heads.add(policy.decode(int(a)))
+        assert len({h[0] for h in heads}) > 1 and len({h[3] for h in heads}) > 1  # several choices per head
+
+
+@pytest.mark.engine
+def test_java_controller_equals_python(install, controls, tmp_path) -> None:
+    reqs = [f"C\t{_nums(k['own'][:2] + k['guns'] + [k['own'][5], k['own'][4], p, c, k['time'], *FIELD])}"
+            f"\t{_rows(k['enemies'])}" for k, p, c, _ in controls]
+    for line, (k, p, c, sim) in zip(_java(install, _policy(0), reqs, tmp_path), controls, strict=True):
+        gun, radar, fire, tgt = (float(x) for x in line.split())
+        x, y = k["own"][:2]
+        assert int(tgt) == robot_target(x, y, k["enemies"], c)
+        g, r, f = robot_control(ControlConfig(), True, x, y, *k["guns"], k["own"][5], k["own"][4], k["enemies"],
+                                int(tgt), p, k["time"], *FIELD)
+        assert (math.isnan(g) and math.isnan(gun)) or abs(gun - g) <= 1e-9, line
+        assert abs(radar - r) <= 1e-9 and fire == f == sim[2], line
+
+
+# -- the policy file and the run folder -----------------------------------------------------------------
+
+
+def test_policy_from_state_and_checks() -> None:
+    p = _policy(4)
+    torch_names = {}
+    for i, (w, b) in enumerate(zip(p.weights, p.biases, strict=True)):
+        torch_names[f"actor.{2 * i}.weight"], torch_names[f"actor.{2 * i}.bias"] = w, b
+    torch_names["critic.0.weight"] = np.zeros((3, 3))
+    q = TankPolicy.from_state(torch_names, SPACE, step_turns=5)
+    view = np.random.default_rng(0).uniform(-1, 1, SPACE.n_features)
+    assert q.act(view) == p.act(view)
+    d, t, power, k = p.decode(p.act(view))
+    assert d in SPACE.distances and power in (-1.0, 1.0, 2.0, 3.0) and 0 <= k < SPACE.enemy_slots
+    text = p.to_text()
+    assert text.startswith("confront-tank 1\n") and "matrix w2 18 24" in text and "lead linear" in text
+    with pytest.raises(ValueError, match="chain"):
+        TankPolicy((np.zeros((4, 5)),), (np.zeros(4),))
+    with pytest.raises(ValueError, match="logits"):
+        TankPolicy((np.zeros((4, SPACE.n_features)),), (np.zeros(4),))
+    with pytest.raises(ValueError, match="actor"):
+        TankPolicy.from_state({"x": np.zeros(2)})
+
+
+def _write_run(run: Path, policy: TankPolicy) -> None:
+    model = run / "model"
+    model.mkdir(parents=True)
+    (model / "model.json").write_text(json.dumps({"kind": "ppo"}))
+    np.savez(model / "actor.npz", **{f"{n}{i}": a for i, (w, b) in enumerate(zip(policy.weights, policy.biases,
+                                                                                  strict=True))
+                                     for n, a in (("w", w), ("b", b))})
+    s = policy.space
+    (model / "tank.json").write_text(json.dumps({
+        "distances": list(s.distances), "turns_deg": list(s.turns_deg), "fire_powers": list(s.fire_powers),
+        "enemy_slots": s.enemy_slots, "mate_slots": s.mate_slots, "lead": s.lead, "step_turns": policy.step_turns,
+        "control": {"radar_overshoot": policy.control.radar_overshoot, "aim_tolerance": 0.04}}))
+
+
+def test_run_folder_loads(tmp_path) -> None:
+    space = TankSpace(distances=(-100.0, 100.0), enemy_slots=1, mate_slots=0)
+    p = _policy(5, hidden=8, space=space)
+    _write_run(tmp_path / "run", p)
+    assert is_tank_run(tmp_path / "run") and not is_tank_run(tmp_path)
+    q = load_tank_policy(tmp_path / "run")
+    assert q.space == space and q.step_turns == 5 and q.control.aim_tolerance == 0.04
+    assert q.to_text().split("aim_tolerance")[0] == p.to_text().split("aim_tolerance")[0]
+
+
+# -- the exported robot in the engine -------------------------------------------------------------------
+
+
+@pytest.mark.engine
+def test_exported_tank_robot_plays(install, tmp_path) -> None:
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+    from confront.engine.battle import BattleSpec
+    from confront.engine.runner import EngineOptions, run_battle
+
+    _write_run(tmp_path / "run", _policy(6))
+    jar = tmp_path / "out" / "tankbot.jar"
+    res = CliRunner().invoke(cli, ["export", str(tmp_path / "run"), "--out", str(jar)])
+    assert res.exit_code == 0, res.output
+    assert "confront.TankBot" in res.output
+    names = set(zipfile.ZipFile(jar).namelist())
+    assert {"confront/TankBot.class", "confront/TankModel.class", "confront/TankData.class",
+            "confront/RoundStart.class", "confront/tank_policy.txt", "confront/TankBot.properties"} <= names
+    folder = export_tank_robot(_policy(6), tmp_path / "robots", install)
+    assert (folder / "confront" / "TankData.class").is_file()
+    run = run_battle(BattleSpec(("confront.TankBot 1.0", "sample.SittingDuck"), rounds=1), EngineOptions(seed=3),
+                     extra_robots=[jar])
+    reports = run.summary["robot_reports"]
+    assert not run.errors and run.results.rounds == 1
+    assert not [r for r in reports if "tank-error" in r or "tank-load-failed" in r or "Exception" in r], reports
+    rounds = [r for r in reports if "tank-round" in r]
+    assert rounds and int(rounds[0].split("decisions=")[1].split()[0]) > 10, reports

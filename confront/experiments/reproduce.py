@@ -2,14 +2,18 @@
 
 Each experiment is a list of arms (config overrides on a packaged base config) run for every seed; runs
 are ordinary run folders under ``<out>/<experiment>/runs/<arm>/seed-<k>``, so an interrupted reproduce
-resumes where it stopped. Claims are tested on per-seed values of the last ``tail`` rounds (default 100)
-with a one-sided permutation test and Hedges' g; a claim holds when p < 0.05 in the paper's direction.
+resumes where it stopped. Claims are tested on per-seed values of the last ``tail`` rounds (default 100).
+Arms of one seed are paired: they share the seed's TD team, its first-round start positions and the
+opponent's random stream, so arms are compared by a paired permutation test (sign flips of the per-seed
+differences), the mean difference with its BCa 95% interval and the difference the seeds could detect (power
+0.8). Every claim gets one of three verdicts, holds / partly / no, with the criterion that decided it.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -18,12 +22,16 @@ from pathlib import Path
 
 import click
 import numpy as np
+from scipy import stats
 
 from confront.experiments.plots import plot_curves
-from confront.experiments.stats import hedges_g, interval, permutation_test
+from confront.experiments.stats import interval, mde_t, paired_comparison, paired_permutation_test
 from confront.runs import Run
 
 EXPERIMENTS = ("migration", "awm", "fuzzy", "transfer", "baselines")
+MIGRATION_SEEDS = 1000  # the tabular task runs all seeds side by side in seconds
+ALPHA = 0.05
+VERDICTS = {"holds": True, "partly": False, "no": False, "n/a": None}
 
 
 @dataclass(frozen=True)
@@ -41,13 +49,28 @@ class Job:
 
 @dataclass
 class Claim:
-    """A claim of the paper, tested on our runs."""
+    """A claim of the paper, tested on our runs: our values, the tested effect with its 95% interval, p, the
+    effect the seeds could detect (power 0.8) and a verdict (holds / partly / no / n/a) with its criterion.
+
+    Given only ``holds``, the verdict is holds / no / n/a; given a verdict, ``holds`` follows from it."""
 
     text: str
     figure: str
     ours: str
-    holds: bool | None
+    holds: bool | None = None
     detail: str = ""
+    effect: str = ""
+    p: str = ""
+    mde: str = ""
+    verdict: str = ""
+    criterion: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.verdict:
+            self.verdict = {True: "holds", False: "no", None: "n/a"}[self.holds]
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"bad value verdict={self.verdict!r}: must be one of {', '.join(VERDICTS)}")
+        self.holds = VERDICTS[self.verdict]
 
 
 @dataclass
@@ -61,6 +84,8 @@ class Outcome:
     seconds: float = 0.0  # wall time of this call
     run_seconds: float = 0.0  # summed wall time of the training runs (also those reused from an earlier call)
     runs: int = 0
+    seeds: int = 0  # seeds actually run per arm
+    note: str = ""  # how the claims were obtained when not from this call's runs
 
 
 def _run_job(job: Job, rounds: int | None, engine: str = "sim") -> str:
@@ -158,22 +183,53 @@ def _fluctuation(folders: Sequence[Path]) -> np.ndarray:
     return np.abs(np.diff(m, axis=1)).mean(axis=1)
 
 
+def _fmt(x: float) -> str:
+    return f"{x:.3g}" if abs(x) < 1000 else f"{x:.0f}"
+
+
 def compare(text: str, figure: str, a: np.ndarray, b: np.ndarray, name_a: str, name_b: str, rng: np.random.Generator,
-            alternative: str = "greater", what: str = "score ratio") -> Claim:
-    """Test "a > b" (or "a < b") on per-seed values."""
-    p = permutation_test(a, b, rng, alternative=alternative)
-    g = hedges_g(a, b)
+            alternative: str = "greater", what: str = "score ratio", paper_diff: float | None = None) -> Claim:
+    """Test "a > b" (or "a < b") on per-seed values of two arms run on the same seeds (paired)."""
+    res = paired_comparison(a, b, rng, alternative=alternative)
+    d = res.diff
+    sign = 1.0 if alternative == "greater" else -1.0
+    right = res.p < ALPHA
+    short = paper_diff is not None and sign * (d.hi if sign > 0 else d.lo) < sign * paper_diff
+    verdict = ("partly" if short else "holds") if right else "no"
+    crit = f"holds if a paired permutation test finds {name_a} {'>' if sign > 0 else '<'} {name_b} at p < {ALPHA}"
+    if paper_diff is not None:
+        crit += f" and the 95% CI reaches the paper's difference ({paper_diff:+.2g}); partly if only the direction"
+    crit += "; no otherwise"
     ia, ib = interval(a, rng), interval(b, rng)
-    return Claim(text, figure, f"{name_a} {ia} vs {name_b} {ib} ({what}); p = {p:.3g}, g = {g:.2f}", p < 0.05,
-                 detail=f"n = {a.size}/{b.size} seeds")
+    return Claim(text, figure, f"{name_a} {ia} vs {name_b} {ib} ({what}; {res.n} seeds, paired)",
+                 effect=f"{name_a} - {name_b} {_fmt(d.mean)} [{_fmt(d.lo)}, {_fmt(d.hi)}] (d_z {res.dz:.2f})",
+                 p=f"{res.p:.3g}", mde=f"{_fmt(res.mde)}", verdict=verdict, criterion=crit,
+                 detail=f"n = {res.n} seeds, paired")
+
+
+def _level_verdict(lo: float, hi: float, target: float, tol: float) -> str:
+    if target - tol <= lo and hi <= target + tol:
+        return "holds"
+    return "partly" if lo <= target + tol and hi >= target - tol else "no"
+
+
+def _level_criterion(target: float, tol: float) -> str:
+    return (f"holds if the 95% CI lies within {target} +- {tol}; partly if it overlaps that band (the paper's level "
+            "not excluded, not shown); no if it lies outside")
 
 
 def level_claim(text: str, figure: str, values: np.ndarray, target: float, tol: float, rng: np.random.Generator,
                 name: str) -> Claim:
-    """Test "values stay near target": the 95% interval lies within target +- tol."""
-    iv = interval(values, rng)
-    holds = target - tol <= iv.lo and iv.hi <= target + tol
-    return Claim(text, figure, f"{name} {iv}", holds, detail=f"holds if the interval lies in {target} +- {tol}")
+    """Test "values stay near target": the 95% interval of the mean against target +- tol."""
+    v = np.asarray(values, float)
+    iv = interval(v, rng)
+    p = paired_permutation_test(v, np.full_like(v, target), rng, alternative="two-sided")
+    mde = mde_t(float(v.std(ddof=1)) / np.sqrt(v.size), v.size - 1, two_sided=True) if v.size > 1 else float("nan")
+    return Claim(text, figure, f"{name} {iv} ({v.size} seeds)",
+                 effect=f"mean - {target} {_fmt(iv.mean - target)} [{_fmt(iv.lo - target)}, {_fmt(iv.hi - target)}]",
+                 p=f"{p:.3g} (mean = {target}, sign flips)", mde=f"{_fmt(mde)}",
+                 verdict=_level_verdict(iv.lo, iv.hi, target, tol), criterion=_level_criterion(target, tol),
+                 detail=f"n = {v.size} seeds")
 
 
 # -- the experiments --------------------------------------------------------------------------------------------
@@ -205,6 +261,7 @@ def _session_figures(outcome: Outcome, fig_dir: Path, jobs: dict[str, list[Job]]
                                                    for a, f in folders.items()}))
 
 
+PAPER_FLM_GAIN = 0.1  # §6.3: FLM's score ratio near 0.8, the fixed rates' near 0.7
 RANDOM_ARM = "random moves"  # reference arm beyond the paper: uniform moves, same gun controller, never learns
 
 
@@ -273,7 +330,8 @@ def fuzzy(seeds: int, out: Path, rng: np.random.Generator, tail: int) -> tuple[l
             other = _tail_values(folders[arm], "score_ratio", tail)
             o.claims.append(level_claim(f"{arm}'s score ratio stays around 0.7", "Fig. 14", other, 0.7, 0.05, rng,
                                         arm))
-            o.claims.append(compare(f"FLM scores a higher ratio than {arm}", "Fig. 14", flm, other, "FLM", arm, rng))
+            o.claims.append(compare(f"FLM scores a higher ratio than {arm}", "Fig. 14", flm, other, "FLM", arm, rng,
+                                    paper_diff=PAPER_FLM_GAIN))
         o.claims.append(_beats_random("FLM", folders, tail, rng))
         return o
 
@@ -340,46 +398,155 @@ def _head_values(folders: Sequence[Path], head: int) -> np.ndarray:
     return np.array(out)
 
 
-def migration_outcome(seeds: int, out: Path, episodes: int | None, workers: int = 1) -> Outcome:
-    """§6.2: delegated to confront.learning.migration (no arena needed)."""
+def migration_outcome(seeds: int, out: Path, episodes: int | None) -> Outcome:
+    """§6.2: delegated to confront.learning.migration (no arena needed); all seeds side by side."""
     from confront.learning import migration as mig
 
-    o = Outcome("migration")
+    o = Outcome("migration", seeds=seeds)
     start = time.time()
-    kwargs: dict = {"seeds": seeds, "workers": workers}
+    kwargs: dict = {"seeds": seeds}
     if episodes is not None:
         kwargs["episodes"] = episodes
     result = mig.run_migration(**kwargs)
     fig_dir = out / "migration" / "figures"
     fig_dir.mkdir(parents=True, exist_ok=True)
     o.figures.extend(Path(p) for p in mig.plot_migration(result, fig_dir))
-    table = mig.convergence_table(result)
-    o.tables.append(table)
-    (out / "migration" / "convergence.md").write_text(table + "\n")
-    for claim in mig.paper_claims(result):
-        o.claims.append(Claim(claim["text"], "Fig. 9", claim["ours"], claim["holds"], claim.get("detail", "")))
+    settings = result.settings
+    intro = (f"{result.seeds} seeds (seeds {settings['seed']} .. {settings['seed'] + result.seeds - 1}), "
+             f"{settings['episodes']} episodes, {settings['layers']} layers; every method reads the same uniform "
+             "draws per move (common random numbers). Convergence episode: median [interquartile range].")
+    tables = [intro, "", mig.convergence_table(result), "", mig.paired_table(result), ""]
+    o.tables.extend(tables)
+    (out / "migration" / "convergence.md").write_text("\n".join(tables))
+    for c in mig.paper_claims(result):
+        o.claims.append(Claim(c["text"], "Fig. 9", c["ours"], effect=c["effect"], p=c["p"], mde=c["mde"],
+                              verdict=c["verdict"], criterion=c["criterion"], detail=f"n = {result.seeds} seeds"))
     o.seconds = time.time() - start
+    return o
+
+
+def baseline_claims(csv_path: Path, rng: np.random.Generator, opponent: str = "td") -> list[Claim]:
+    """Beyond the paper, from the baselines' per-seed results: does each trained method beat random moves, and
+    does training beat the untrained DMNN? Paired by seed (every method plays the same evaluation battles)."""
+    import csv
+
+    with open(csv_path, newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["opponent"] == opponent]
+    by: dict[str, dict[int, float]] = {}
+    for r in rows:
+        by.setdefault(r["method"], {})[int(r["seed"])] = float(r["score_ratio"])
+    pairs = [(m, "Random moves") for m in ("DMNN (FLM)", "DQN (SB3)", "PPO (SB3)")]
+    pairs.append(("DMNN (FLM)", "DMNN (untrained)"))
+    label = "the TD team" if opponent == "td" else opponent
+    out = []
+    for a, b in pairs:
+        if a not in by or b not in by:
+            continue
+        seeds = sorted(set(by[a]) & set(by[b]))
+        va, vb = np.array([by[a][k] for k in seeds]), np.array([by[b][k] for k in seeds])
+        out.append(compare(f"beyond the paper: {a} scores a higher ratio than {b} (vs {label})", "-", va, vb, a, b,
+                           rng))
+    return out
+
+
+# -- restating committed claims without re-running the battles ---------------------------------------------------
+
+_NUM = r"(-?[\d.]+(?:e-?\d+)?)"
+_COMPARE = re.compile(rf"^(.+?) {_NUM} \[{_NUM}, {_NUM}\] vs (.+?) {_NUM} \[{_NUM}, {_NUM}\] \((.*)\); "
+                      rf"p = {_NUM}, g = {_NUM}$")
+_LEVEL = re.compile(rf"^(.+?) {_NUM} \[{_NUM}, {_NUM}\]$")
+_BAND = re.compile(rf"lies in {_NUM} \+- {_NUM}")
+
+
+def restate_claim(c: dict, seeds: int) -> Claim:
+    """A claim from a claims.json written before paired tests, given three verdicts and a detectable effect from
+    its own numbers: the arms' means and 95% bootstrap intervals (standard error = interval width / 3.92)
+    and the unpaired permutation p of that run. Claims already in the new form are returned as they are."""
+    keys = ("text", "figure", "ours", "holds", "detail", "effect", "p", "mde", "verdict", "criterion")
+    if c.get("verdict") and c.get("criterion"):
+        return Claim(**{k: c[k] for k in keys if k in c})
+    text, fig, ours = c["text"], c["figure"], c["ours"]
+    note = "; restated from the committed summary (per-seed values not committed): unpaired, normal approximation"
+    m = _COMPARE.match(ours)
+    if m:
+        a, ma, la, ha, b, mb, lb, hb, what, p, _g = m.groups()
+        ma, la, ha, mb, lb, hb, pv = map(float, (ma, la, ha, mb, lb, hb, p))
+        se = float(np.hypot((ha - la) / 3.92, (hb - lb) / 3.92))
+        sign = -1.0 if ("less" in text or "fluctuates" in text) else 1.0
+        d = ma - mb
+        lo, hi = d - 1.96 * se, d + 1.96 * se
+        paper = PAPER_FLM_GAIN if text.startswith("FLM scores a higher ratio than LM") else None
+        short = paper is not None and (hi if sign > 0 else -lo) < paper
+        verdict = ("partly" if short else "holds") if pv < ALPHA else "no"
+        crit = f"holds if {a} {'>' if sign > 0 else '<'} {b} at p < {ALPHA}"
+        if paper is not None:
+            crit += f" and the 95% CI reaches the paper's difference ({paper:+.2g}); partly if only the direction"
+        return Claim(text, fig, ours, effect=f"{a} - {b} {_fmt(d)} [{_fmt(lo)}, {_fmt(hi)}]", p=f"{pv:.3g}",
+                     mde=_fmt(mde_t(se, 2 * seeds - 2)), verdict=verdict, criterion=crit + "; no otherwise" + note,
+                     detail=c.get("detail", ""))
+    m, band = _LEVEL.match(ours), _BAND.search(c.get("detail", ""))
+    if m and band:
+        _name, mean, lo, hi = m.groups()
+        mean, lo, hi = float(mean), float(lo), float(hi)
+        target, tol = map(float, band.groups())
+        se = (hi - lo) / 3.92
+        p = 2 * stats.t.sf(abs(mean - target) / se, seeds - 1) if se > 0 else float("nan")
+        return Claim(text, fig, ours, effect=f"mean - {target} {_fmt(mean - target)} [{_fmt(lo - target)}, "
+                     f"{_fmt(hi - target)}]", p=f"{p:.3g} (t, mean = {target})",
+                     mde=_fmt(mde_t(se, seeds - 1, two_sided=True)), verdict=_level_verdict(lo, hi, target, tol),
+                     criterion=_level_criterion(target, tol) + note, detail=f"n = {seeds} seeds")
+    return Claim(text, fig, ours, c.get("holds"), detail=c.get("detail", ""))
+
+
+def restated_outcome(name: str, out: Path, seeds: int) -> Outcome:
+    """An experiment's claims from its committed ``claims.json`` (and the baselines' ``results.csv``), not re-run."""
+    claims = json.loads((out / name / "claims.json").read_text())
+    o = Outcome(name, seeds=seeds, note="not re-run: claims restated from the committed results")
+    if name == "baselines":
+        o.claims = [restate_claim(c, seeds) for c in claims if "ranking" in c["text"]]
+        csv_path = out / "baselines" / "results.csv"
+        if csv_path.exists():
+            o.claims += baseline_claims(csv_path, np.random.default_rng(12345))
+            o.note = "not re-run: paired tests recomputed from the committed per-seed results.csv"
+    else:
+        o.claims = [restate_claim(c, seeds) for c in claims]
+    o.figures = sorted((out / name / "figures").glob("*.png"))
     return o
 
 
 # -- report ------------------------------------------------------------------------------------------------------
 
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")  # a "|" inside a cell would split it
+
+
 def write_report(out: Path, outcomes: Sequence[Outcome], seeds: int, rounds: int | None) -> Path:
     """``report.md`` and ``report.html`` in ``out``: claims table, figures (paths relative to ``out``), wall times."""
+    ran = ", ".join(f"{o.name} {o.seeds}" for o in outcomes)
     lines = ["# confront: the paper's claims, re-run", "",
-             f"Seeds per arm: {seeds}. Rounds per arm: {rounds or 'as in the paper (500)'}. "
-             "Claims are tested on per-seed values of the last rounds (one-sided permutation test, p < 0.05; "
-             "Hedges' g as effect size; 95% bootstrap intervals). Nothing was tuned to make a claim hold.", "",
-             "| experiment | claim in the paper | paper's figure | our value [95% CI] | holds? |",
-             "|---|---|---|---|---|"]
+             f"Seeds actually run per arm: {ran}. Rounds per arm: {rounds or 'as in the paper (500)'}. "
+             "Battle claims are tested on per-seed values of the last rounds; arms of one seed are paired (same TD "
+             "team, same first-round start positions, same opponent random stream): paired permutation test (sign "
+             "flips, exact up to 14 seeds), mean difference with its BCa 95% interval, and the difference the seeds "
+             f"detect with power 0.8 at p < {ALPHA} (paired t approximation). Migration: paired sign tests on the "
+             "convergence episode over seeds with common random numbers; 'detectable' is then a share of seeds. "
+             "Verdicts: holds / partly (direction right, magnitude or a named part not) / no, each with its "
+             "criterion. Nothing was tuned to make a claim hold.", ""]
+    lines += [f"- {o.name}: {o.note}" for o in outcomes if o.note]
+    lines += ["", "| experiment | claim in the paper | paper's figure | ours [95% CI] | effect [95% CI] | p | "
+              "detectable (power 0.8) | verdict | criterion |", "|---|---|---|---|---|---|---|---|---|"]
     for o in outcomes:
         for c in o.claims:
-            mark = {True: "yes", False: "**no**", None: "n/a"}[c.holds]
-            lines.append(f"| {o.name} | {c.text} | {c.figure} | {c.ours} | {mark} |")
+            mark = c.verdict if c.verdict in ("holds", "n/a") else f"**{c.verdict}**"
+            cells = [o.name, c.text, c.figure, c.ours, c.effect or "-", c.p or "-", c.mde or "-", mark,
+                     c.criterion or c.detail or "-"]
+            lines.append("| " + " | ".join(_cell(x) for x in cells) + " |")
     lines += ["", "## Wall time", "", "Runs already finished by an earlier call are reused, so this call's time can be "
               "short; the summed run time counts every run's own wall time (runs execute in parallel workers).", "",
-              "| experiment | this call (s) | training runs | summed run time (s) |", "|---|---:|---:|---:|"]
-    lines += [f"| {o.name} | {o.seconds:.0f} | {o.runs} | {o.run_seconds:.0f} |" for o in outcomes]
+              "| experiment | seeds | this call (s) | training runs | summed run time (s) |",
+              "|---|---:|---:|---:|---:|"]
+    lines += [f"| {o.name} | {o.seeds} | {'not re-run' if o.note else f'{o.seconds:.0f}'} | {o.runs} | "
+              f"{o.run_seconds:.0f} |" for o in outcomes]
     for o in outcomes:
         lines += ["", f"## {o.name}", ""]
         lines += o.tables
@@ -428,15 +595,25 @@ def _write_html(path: Path, md: str) -> None:
                     + "\n".join(body))
 
 
+def _save_claims(out: Path, o: Outcome) -> None:
+    (out / o.name).mkdir(parents=True, exist_ok=True)
+    (out / o.name / "claims.json").write_text(json.dumps([c.__dict__ for c in o.claims], indent=1))
+
+
 def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = None, out: Path | None = None,
               workers: int | None = None, tail: int = 100, episodes: int | None = None, engine: str = "sim"
               ) -> list[Outcome]:
-    """Run ``experiment`` (or ``all``) in the simulator or the real engine and write the report."""
+    """Run ``experiment`` (or ``all``) in the simulator or the real engine and write the report.
+
+    ``seeds``: seeds per arm (default 10); migration runs ``seeds`` when it is the experiment asked for, else
+    1000 (all side by side in seconds)."""
+    if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1):
+        raise ValueError(f"bad value seeds={seeds!r}: must be a whole number >= 1")
     out = Path(out or ("results" if engine == "sim" else "results-robocode"))
     out.mkdir(parents=True, exist_ok=True)
     names = [e for e in EXPERIMENTS if e != "baselines"] if experiment == "all" else [experiment]
     workers = workers or os.cpu_count() or 1
-    n_seeds = seeds or 10
+    n_seeds = 10 if seeds is None else seeds
     tail = min(tail, rounds // 2) if rounds else tail
     rng = np.random.default_rng(12345)
     outcomes = []
@@ -445,31 +622,66 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
         click.echo(f"== {name}")
         start = time.time()
         if name == "migration":
-            # the tabular task is cheap: 3 seeds per requested seed (30 for the default 10), never fewer than 2
-            outcomes.append(migration_outcome(max(3 * n_seeds, 2), out, episodes, workers))
+            mig_seeds = seeds if experiment == "migration" and seeds is not None else MIGRATION_SEEDS
+            outcomes.append(migration_outcome(mig_seeds, out, episodes))
         elif name == "baselines":
             from confront.experiments.baselines import baselines_outcome
 
             outcomes.append(baselines_outcome(n_seeds, out, rounds, workers))
+            outcomes[-1].claims += baseline_claims(out / "baselines" / "results.csv", rng)
+            outcomes[-1].seeds = n_seeds
         else:
             jobs, analyse = builders[name](n_seeds, out, rng, tail)
             run_jobs(jobs, rounds, workers, engine)
             outcomes.append(analyse())
             outcomes[-1].runs = len(jobs)
+            outcomes[-1].seeds = n_seeds
             outcomes[-1].run_seconds = sum(json.loads((j.folder / "summary.json").read_text())["wall_time_s"]
                                            for j in jobs)
         outcomes[-1].seconds = time.time() - start
         click.echo(f"   {name}: {outcomes[-1].seconds:.0f} s")
-        (out / name).mkdir(parents=True, exist_ok=True)
-        (out / name / "claims.json").write_text(json.dumps([c.__dict__ for c in outcomes[-1].claims], indent=1))
+        _save_claims(out, outcomes[-1])
     # `all` writes the report at the top; a single experiment writes <out>/<experiment>/report.md
     report = write_report(out if experiment == "all" else out / experiment, outcomes, n_seeds, rounds)
     click.echo(f"report: {report}")
     return outcomes
 
 
+def restate(out: Path, battle_seeds: int = 10, migration_seeds: int = MIGRATION_SEEDS, rounds: int | None = None
+            ) -> list[Outcome]:
+    """Re-run the migration experiment and restate the battle experiments' committed claims (no training):
+    the report of ``out`` (and of ``out/baselines``) regenerated with the current statistics."""
+    out = Path(out)
+    outcomes = [migration_outcome(migration_seeds, out, None)]
+    _save_claims(out, outcomes[0])
+    for name in ("awm", "fuzzy", "transfer"):
+        if (out / name / "claims.json").exists():
+            outcomes.append(restated_outcome(name, out, battle_seeds))
+            _save_claims(out, outcomes[-1])
+    if (out / "baselines" / "claims.json").exists():
+        csv_path = out / "baselines" / "results.csv"
+        seeds = len({r.split(",")[1] for r in csv_path.read_text().splitlines()[1:]}) if csv_path.exists() else 0
+        base = restated_outcome("baselines", out, seeds)
+        ranking = out / "baselines" / "ranking.md"
+        if ranking.exists():
+            base.tables = [ranking.read_text()]
+        _save_claims(out, base)
+        write_report(out / "baselines", [base], seeds, rounds)
+        outcomes.append(base)
+    write_report(out, outcomes, battle_seeds, rounds)
+    return outcomes
+
+
+class BadSeeds(click.ClickException):
+    """A refused seed count: one line on stderr, exit status 2 (a usage error)."""
+
+    exit_code = 2
+
+
 def reproduce_cli(experiment: str, seeds: int | None, rounds: int | None, engine: str, out: Path | None,
                   workers: int | None, overrides: tuple[str, ...]) -> None:
+    if seeds is not None and seeds < 1:
+        raise BadSeeds(f"--seeds must be at least 1, got {seeds} (no run was started)")
     if engine == "robocode" and experiment in ("baselines", "all"):
         raise click.UsageError("--engine robocode runs awm, fuzzy or transfer (hours at 500 rounds per run); "
                                "migration needs no engine and the SB3 baselines train in the simulator")
@@ -477,6 +689,28 @@ def reproduce_cli(experiment: str, seeds: int | None, rounds: int | None, engine
         raise click.UsageError("reproduce takes no --set: edit a copy of the experiment's TOML instead")
     outcomes = reproduce(experiment, seeds=seeds, rounds=rounds, out=out, workers=workers, engine=engine)
     for o in outcomes:
+        click.echo(f"[{o.name}] {o.seeds} seeds")
         for c in o.claims:
-            mark = {True: "holds", False: "does NOT hold", None: "n/a"}[c.holds]
-            click.echo(f"[{o.name}] {c.text}: {mark} — {c.ours}")
+            click.echo(f"[{o.name}] {c.text}: {c.verdict} — {c.effect or c.ours}; p {c.p or '-'}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m confront.experiments.reproduce restate OUT``: regenerate OUT's report from its committed claims
+    (battle experiments not re-run) and a fresh migration run."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=main.__doc__)
+    ap.add_argument("command", choices=["restate"])
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--battle-seeds", type=int, default=10, help="seeds per arm of the committed battle runs")
+    ap.add_argument("--migration-seeds", type=int, default=MIGRATION_SEEDS)
+    args = ap.parse_args(argv)
+    if args.battle_seeds < 1 or args.migration_seeds < 1:
+        ap.error("--battle-seeds and --migration-seeds must be at least 1")
+    for o in restate(args.out, args.battle_seeds, args.migration_seeds):
+        for c in o.claims:
+            print(f"[{o.name}] {c.verdict}: {c.text} — {c.effect}; p {c.p}; detectable {c.mde}")
+
+
+if __name__ == "__main__":
+    main()

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from confront.experiments.reproduce import reproduce
+from confront.experiments.reproduce import Claim, compare, reproduce, restate_claim
 from confront.runs import Run
 
 
@@ -24,10 +24,16 @@ def tiny(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_report_has_every_claim(tiny: Path) -> None:
     report = (tiny / "report.md").read_text()
+    assert "Seeds actually run per arm: migration 1000, awm 2, fuzzy 2, transfer 2." in report
+    assert "| effect [95% CI] | p | detectable (power 0.8) | verdict | criterion |" in report
     for name in ("migration", "awm", "fuzzy", "transfer"):
         assert f"| {name} |" in report
         claims = json.loads((tiny / name / "claims.json").read_text())
-        assert claims and all(c["holds"] in (True, False, None) for c in claims)
+        assert claims and all(c["verdict"] in ("holds", "partly", "no", "n/a") for c in claims)
+        assert all(c["holds"] == {"holds": True, "partly": False, "no": False, "n/a": None}[c["verdict"]]
+                   for c in claims)
+        assert all(c["effect"] and c["p"] and c["mde"] and c["criterion"] for c in claims)
+    assert "Paired over 1000 seeds" in (tiny / "migration" / "convergence.md").read_text()
     for fig in ("awm/figures/fig10_12_score_ratio.png", "awm/figures/fig11_fluctuation.png",
                 "fuzzy/figures/fig13_fuzzy_learning_rate.png", "fuzzy/figures/fig14_scores.png",
                 "transfer/figures/fig16_17_score_ratio.png", "transfer/figures/fig18_score_ratio.png"):
@@ -79,3 +85,80 @@ def test_rerun_reuses_finished_runs(tiny: Path) -> None:
     before = summary.stat().st_mtime_ns
     reproduce("awm", seeds=2, rounds=8, out=tiny, workers=1)
     assert summary.stat().st_mtime_ns == before
+
+
+def test_arms_of_one_seed_share_the_world_and_the_opponent(tiny: Path) -> None:
+    """Changing only the learner leaves the draws identical: the arms of a seed differ in learner and transfer
+    keys only, so they get the same arena seed (start positions), TD team and opponent stream."""
+    from confront.arena.smdp import TeamBattleEnv
+    from confront.config import to_dict
+    from confront.experiments.reproduce import awm, fuzzy, transfer
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import scenario_of, smdp_config, td_team
+
+    for build in (awm, fuzzy, transfer):
+        jobs, _ = build(2, tiny, np.random.default_rng(0), 4)
+        groups: dict[tuple[int, str], list] = {}
+        for j in jobs:
+            cfg = load_experiment(j.base, j.overrides + (f"train.seed={j.seed}",))
+            groups.setdefault((j.seed, cfg.arena.scenario), []).append(cfg)
+        for (seed, _scenario), cfgs in groups.items():
+            world = [{k: to_dict(c)[k] for k in ("arena", "opponent")} | {"seed": c.train.seed} for c in cfgs]
+            assert all(w == world[0] for w in world) and world[0]["seed"] == seed
+    cfgs = [load_experiment("awm", (f"learner.awm={v}", "train.seed=1")) for v in ("true", "false")]
+    assert cfgs[0].learner != cfgs[1].learner
+    states = []
+    for cfg in cfgs:
+        env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=cfg.arena.battles, seed=cfg.train.seed,
+                            opponents="td", config=smdp_config(cfg))
+        states.append(env.state_dict())
+    assert states[0].keys() == states[1].keys()
+    for k in states[0]:
+        np.testing.assert_array_equal(states[0][k], states[1][k], err_msg=k)
+    assert td_team(cfgs[0], 4)[1] == td_team(cfgs[1], 4)[1]
+
+
+def test_bad_seed_counts_are_refused_in_one_line() -> None:
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+
+    for bad in ("0", "-1"):
+        res = CliRunner().invoke(cli, ["reproduce", "migration", "--seeds", bad])
+        assert res.exit_code == 2
+        assert res.output.strip() == f"Error: --seeds must be at least 1, got {bad} (no run was started)"
+    for bad in (0, -1):
+        with pytest.raises(ValueError, match="seeds"):
+            reproduce("migration", seeds=bad)
+
+
+def test_paired_compare_gives_three_verdicts() -> None:
+    rng = np.random.default_rng(0)
+    b = rng.normal(0.5, 0.05, 10)
+    noise = np.linspace(-0.01, 0.01, 10)
+    # 0.05 better on every seed: significant, but the CI stays below the paper's +0.1 -> partly
+    c = compare("x", "-", b + 0.05 + noise, b, "A", "B", rng, paper_diff=0.1)
+    assert c.verdict == "partly" and c.holds is False and float(c.p) == pytest.approx(1 / 1024, rel=1e-3)
+    assert c.effect.startswith("A - B 0.05 [")
+    assert compare("x", "-", b + 0.15 + noise, b, "A", "B", rng, paper_diff=0.1).verdict == "holds"
+    worse = compare("x", "-", b - 0.05 + noise, b, "A", "B", rng)
+    assert worse.verdict == "no" and float(worse.p) == pytest.approx(1.0)
+    assert Claim("t", "-", "o", None).verdict == "n/a" and Claim("t", "-", "o", verdict="partly").holds is False
+    with pytest.raises(ValueError, match="verdict"):
+        Claim("t", "-", "o", verdict="maybe")
+
+
+def test_committed_claims_are_restated_from_their_numbers() -> None:
+    old = {"text": "With TF the score ratio is higher than without (4v6)", "figure": "Fig. 16",
+           "ours": "with TF 0.5 [0.4, 0.6] vs without TF 0.3 [0.2, 0.4] (score ratio); p = 0.01, g = 1.00",
+           "holds": True, "detail": "n = 10/10 seeds"}
+    c = restate_claim(old, 10)
+    # se = hypot(0.2, 0.2) / 3.92 = 0.0722; 0.2 +- 1.96 se = [0.0586, 0.341]
+    assert c.verdict == "holds" and c.effect == "with TF - without TF 0.2 [0.0586, 0.341]" and c.p == "0.01"
+    level = {"text": "FLM's score ratio stays around 0.8", "figure": "Fig. 14", "ours": "FLM 0.78 [0.76, 0.80]",
+             "holds": True, "detail": "holds if the interval lies in 0.8 +- 0.05"}
+    assert restate_claim(level, 10).verdict == "holds"
+    assert restate_claim({**level, "ours": "FLM 0.72 [0.70, 0.76]"}, 10).verdict == "partly"
+    assert restate_claim({**level, "ours": "FLM 0.41 [0.38, 0.43]"}, 10).verdict == "no"
+    new = restate_claim(c.__dict__, 10)
+    assert new == c

@@ -15,9 +15,10 @@ import csv
 import io
 import json
 import math
+import shutil
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -55,22 +56,35 @@ def _clean(v: Any) -> Any:
 
 @dataclass(frozen=True)
 class Run:
-    """A run folder."""
+    """A run folder. ``new``: :meth:`create` made the folder (so a failed start may remove it again)."""
 
     path: Path
+    new: bool = field(default=False, compare=False)
 
     @classmethod
     def create(cls, path: str | Path, config: Mapping[str, Any] | None = None, exist_ok: bool = False) -> Run:
         """Make the folder (and its sub-folders); write the resolved config if given."""
         p = Path(path)
+        if p.exists() and not p.is_dir():
+            raise FileExistsError(f"run folder {p} is an existing file; pick another --out")
         if p.exists() and any(p.iterdir()) and not exist_ok:
             raise FileExistsError(f"run folder {p} already exists; pick another --out or use --resume")
-        for sub in SUBDIRS:
-            (p / sub).mkdir(parents=True, exist_ok=True)
-        run = cls(p)
-        if config is not None:
-            write_atomic(p / "config.toml", to_toml(config).encode())
+        text = to_toml(config).encode() if config is not None else None  # a value TOML cannot hold fails here
+        run = cls(p, new=not p.exists())
+        try:
+            for sub in SUBDIRS:
+                (p / sub).mkdir(parents=True, exist_ok=True)
+            if text is not None:
+                write_atomic(p / "config.toml", text)
+        except BaseException:
+            run.discard_if_new()
+            raise
         return run
+
+    def discard_if_new(self) -> None:
+        """Remove the folder if :meth:`create` made it (after a failed start); an older folder is left alone."""
+        if self.new:
+            shutil.rmtree(self.path, ignore_errors=True)
 
     @property
     def checkpoints(self) -> Path:

@@ -12,20 +12,40 @@ import click
 from confront.checkpoint import CheckpointError
 from confront.config import ConfigError
 
-USER_ERRORS: tuple[type[BaseException], ...] = (ConfigError, CheckpointError, FileExistsError, FileNotFoundError)
+USER_ERRORS: tuple[type[BaseException], ...] = (ConfigError, CheckpointError, FileExistsError, FileNotFoundError,
+                                               NotADirectoryError, IsADirectoryError)
+# optional packages (pyproject extras): a command that needs a missing one is a user's set-up, not a bug
+EXTRAS = {"ray": "distributed", "pyarrow": "parquet", "stable_baselines3": "baselines", "torch": "baselines"}
+SEED = click.IntRange(0, 2**32 - 1)
+COUNT = click.IntRange(min=1)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
 
 
 class Group(click.Group):
-    """A click group that turns user mistakes into one line on stderr and exit code 2."""
+    """A click group that turns user mistakes into one line on stderr and exit code 2: bad options and
+    arguments, configs, checkpoints, files, a missing engine or optional package."""
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
-        except USER_ERRORS as exc:
-            click.echo(f"error: {exc}", err=True)
+        except click.exceptions.Exit:
+            raise
+        except click.UsageError as exc:
+            where = f" (see `{exc.ctx.command_path} --help`)" if exc.ctx is not None else ""
+            click.echo(f"error: {_one_line(exc.format_message())}{where}", err=True)
             sys.exit(2)
-        except _engine_errors() as exc:
-            click.echo(f"error: {exc}", err=True)
+        except USER_ERRORS + _engine_errors() as exc:
+            click.echo(f"error: {_one_line(str(exc))}", err=True)
+            sys.exit(2)
+        except ModuleNotFoundError as exc:
+            top = (exc.name or "").split(".")[0]
+            if top not in EXTRAS:
+                raise
+            click.echo(f"error: this command needs the optional package {top!r}: "
+                       f"pip install 'confront[{EXTRAS[top]}]'", err=True)
             sys.exit(2)
 
 
@@ -52,8 +72,8 @@ def cli() -> None:
 
 @cli.command()
 @click.option("--out", type=click.Path(path_type=Path), default=None, help="Run folder (default runs/demo-<time>).")
-@click.option("--rounds", type=int, default=None, help="Rounds to train (default from the demo config).")
-@click.option("--seed", type=int, default=None)
+@click.option("--rounds", type=COUNT, default=None, help="Rounds to train (default from the demo config).")
+@click.option("--seed", type=SEED, default=None)
 @set_option
 def demo(out: Path | None, rounds: int | None, seed: int | None, overrides: tuple[str, ...]) -> None:
     """Train a small 4v4 fuzzy DMNN team against the TD team, then print and plot the results."""
@@ -67,8 +87,8 @@ def demo(out: Path | None, rounds: int | None, seed: int | None, overrides: tupl
               help="Experiment name (see `confront config list`) or a TOML file.")
 @click.option("--out", type=click.Path(path_type=Path), default=None, help="Run folder to create.")
 @click.option("--resume", type=click.Path(path_type=Path, exists=True, file_okay=False), default=None,
-              help="Continue the run in this folder from its latest checkpoint.")
-@click.option("--seed", type=int, default=None)
+              help="Continue the run in this folder from its latest checkpoint (with its own config).")
+@click.option("--seed", type=SEED, default=None)
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True,
               help="Train in the simulator or live in the real Robocode engine (checkpointed per battle).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
@@ -79,6 +99,14 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import print_summary, train_run
 
+    if resume is not None:  # a resumed run continues with its own config.toml and folder
+        given = [name for name, value in (("--set", overrides), ("--out", out), ("--seed", seed))
+                 if value not in (None, ())]
+        if click.get_current_context().get_parameter_source("config") is click.core.ParameterSource.COMMANDLINE:
+            given.insert(0, "-c")
+        if given:
+            raise click.UsageError(f"--resume continues {resume} with its own config and folder: drop "
+                                   f"{', '.join(given)} (or start a new run without --resume)")
     if engine == "robocode":
         from confront.experiments.train_engine import train_in_engine
 
@@ -101,8 +129,8 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
 @click.option("--opponents", default=None, help="Comma list of opponents (default: the run's).")
-@click.option("--rounds", type=int, default=100, show_default=True)
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--rounds", type=COUNT, default=100, show_default=True)
+@click.option("--seed", type=SEED, default=0, show_default=True)
 def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: int) -> None:
     """Play a trained policy greedily (simulator or real engine) and print its score table."""
     from confront.experiments.evaluate import evaluate_cli
@@ -143,9 +171,9 @@ def sweep(grid: Path, out: Path, address: str | None, seeds: int | None) -> None
 @click.option("--scenario", default="1v1", show_default=True)
 @click.option("--robots", default=None, help="Comma list of robots/teams (default: the scenario's).")
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
-@click.option("--rounds", type=int, default=10, show_default=True)
-@click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--battles", type=int, default=1, show_default=True,
+@click.option("--rounds", type=COUNT, default=10, show_default=True)
+@click.option("--seed", type=SEED, default=0, show_default=True)
+@click.option("--battles", type=COUNT, default=1, show_default=True,
               help="Simulator: split the rounds over this many parallel battles (faster; battle b has seed+b).")
 @click.option("--replay", "replay_out", type=click.Path(path_type=Path), default=None,
               help="Also record the first round to this replay file (.json or .json.gz, plus .gif and .html; "
@@ -162,8 +190,7 @@ def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: in
 @cli.command()
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Robots folder or .jar to write.")
-@click.option("--name", default=None, help="Robot class name (default derived from the run).")
-def export(run: Path, out: Path, name: str | None) -> None:
+def export(run: Path, out: Path) -> None:
     """Export a trained policy as a standalone Robocode robot (no Python needed to run it)."""
     from confront.engine.tank_export import export_tank_cli, is_tank_run
     from confront.experiments.evaluate import export_cli
@@ -171,7 +198,7 @@ def export(run: Path, out: Path, name: str | None) -> None:
     if is_tank_run(run):  # a PPO run over the tank view: confront.TankBot
         export_tank_cli(run, out=out)
         return
-    export_cli(run, out=out, name=name)
+    export_cli(run, out=out, name=None)
 
 
 @cli.command()

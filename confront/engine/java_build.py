@@ -1,7 +1,7 @@
 """Compiling the project's Java sources (runner, script robot, bridge robots) against the engine's jar.
 
 Compiled classes are cached by a hash of the sources and the engine jar, under
-$CONFRONT_CACHE_DIR or $XDG_CACHE_HOME/confront (default ~/.cache/confront).
+$CONFRONT_CACHE (or the older name $CONFRONT_CACHE_DIR) or $XDG_CACHE_HOME/confront (default ~/.cache/confront).
 """
 
 from __future__ import annotations
@@ -23,8 +23,9 @@ ROBOT_HELPERS: tuple[str, ...] = ("RoundStart",)
 
 
 def cache_root() -> Path:
-    """Folder that holds compiled classes (one sub-folder per source hash)."""
-    env = os.environ.get("CONFRONT_CACHE_DIR")
+    """confront's cache folder (compiled classes, TD-team artefacts): $CONFRONT_CACHE, else the older name
+    $CONFRONT_CACHE_DIR, else $XDG_CACHE_HOME/confront or ~/.cache/confront."""
+    env = os.environ.get("CONFRONT_CACHE") or os.environ.get("CONFRONT_CACHE_DIR")
     if env:
         return Path(env)
     xdg = os.environ.get("XDG_CACHE_HOME")

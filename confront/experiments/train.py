@@ -17,7 +17,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import tempfile
 import time
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,6 +32,7 @@ from confront.arena.scenarios import Scenario, get_scenario, load_scenario
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.state import SCORE_PARTS
 from confront.config import load_toml, to_dict
+from confront.engine.java_build import cache_root
 from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.learning.base import Learner, Transition
 from confront.learning.factory import load_learner, make_learner, save_learner
@@ -83,9 +86,14 @@ def _obs(learner: Learner, disc: np.ndarray, feats: np.ndarray) -> np.ndarray:
 def save_model(folder: Path, learner: Learner, meta: dict[str, Any]) -> None:
     """``learner.npz`` (kind, parameters and state; no pickle) + ``model.json`` (the task it was trained on)."""
     folder.mkdir(parents=True, exist_ok=True)
-    tmp = folder / ".learner.npz.tmp"
-    save_learner(tmp, learner.current if isinstance(learner, TransferPolicy) else learner)
-    os.replace(tmp, folder / "learner.npz")
+    fd, name = tempfile.mkstemp(dir=folder, prefix=".learner.", suffix=".npz")  # unique: writers may race
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        save_learner(tmp, learner.current if isinstance(learner, TransferPolicy) else learner)
+        os.replace(tmp, folder / "learner.npz")
+    finally:
+        tmp.unlink(missing_ok=True)
     info = {"format": "confront-model/1", "kind": learner.kind, "observation": learner.observation,
             "n_actions": learner.n_actions, **meta}
     ck.write_atomic(folder / "model.json", json.dumps(info, indent=1, sort_keys=True).encode())
@@ -97,17 +105,18 @@ def load_model(folder: str | Path) -> tuple[Learner, dict[str, Any]]:
     if (p / "model").is_dir():
         p = p / "model"
     try:
-        info = json.loads((p / "model.json").read_text())
-    except FileNotFoundError:
+        info = json.loads((p / "model.json").read_text(encoding="utf-8"))
+    except (FileNotFoundError, NotADirectoryError):
         raise FileNotFoundError(f"no trained model in {folder} (expected model/model.json)") from None
-    except json.JSONDecodeError as exc:
-        raise ck.CheckpointError(f"model {p} has a corrupt model.json ({exc})") from None
-    if info.get("format") != "confront-model/1":
-        raise ck.CheckpointError(f"{p} is not a confront model (format {info.get('format')!r})")
+    except (ValueError, OSError, RecursionError) as exc:  # JSON and Unicode errors are ValueErrors
+        raise ck.CheckpointError(f"model {p} has a corrupt model.json ({str(exc)[:200]})") from None
+    if not isinstance(info, dict) or info.get("format") != "confront-model/1":
+        what = info.get("format") if isinstance(info, dict) else type(info).__name__
+        raise ck.CheckpointError(f"{p} is not a confront model (format {what!r})")
     try:
         learner = load_learner(p / "learner.npz", frozen=False)
-    except (OSError, ValueError, KeyError) as exc:
-        raise ck.CheckpointError(f"model {p} cannot be read: {exc}") from None
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        raise ck.CheckpointError(f"model {p} cannot be read: {str(exc)[:200]}") from None
     return learner, info
 
 
@@ -245,13 +254,15 @@ def td_team(cfg: ExperimentConfig, n_actions: int, progress: bool = False) -> tu
                       "fire_power_actions": cfg.arena.fire_power_actions, "target": cfg.arena.target,
                       "sensing": cfg.arena.sensing, "seed": cfg.train.seed, "version": 2}, sort_keys=True)
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]
-    cache = Path(os.environ.get("CONFRONT_CACHE", Path.home() / ".cache" / "confront")) / "td" / digest
+    cache = cache_root() / "td" / digest
     if (cache / "model.json").exists():
         try:
             learner, _ = load_model(cache)
-            return learner, cache  # type: ignore[return-value]
-        except ck.CheckpointError:
-            pass  # a corrupt cache entry is rebuilt below
+            if not isinstance(learner, TabularQ):
+                raise ck.CheckpointError(f"model {cache} is not a tabular TD model")
+            return learner, cache
+        except (ck.CheckpointError, FileNotFoundError) as exc:  # a corrupt cache entry is rebuilt below
+            click.echo(f"note: the cached TD team cannot be used ({exc}); training it again", err=True)
     learner = td_learner(cfg, n_actions)
     if oc.pretrain_rounds > 0:
         env = TeamBattleEnv(get_scenario("4v4"), n_battles=8, seed=cfg.train.seed + 7919,
@@ -368,7 +379,15 @@ def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool
         raise ValueError("train_run needs a config unless resuming")
     else:
         run = new_run(cfg, out, exist_ok)
-    loop, info = _setup(cfg, progress)
+    if cfg.learner.kind == "ppo":  # the recommended learner: its own rollout loop over the league (tanks.py)
+        from confront.experiments.tanks import train_tanks
+
+        return train_tanks(cfg, run, resume=resume, progress=progress)
+    try:
+        loop, info = _setup(cfg, progress)
+    except Exception:
+        run.discard_if_new()  # a failed start leaves no half-made run folder
+        raise
     elapsed_before = 0.0
     if resume:
         latest = ck.latest(run.checkpoints)
@@ -446,6 +465,10 @@ def _replay(run: Run, cfg: ExperimentConfig, side: Side) -> str | None:
 
 def print_summary(summary: dict[str, Any]) -> None:
     """The results table of a run, for the terminal."""
+    if summary.get("learner") == "ppo":
+        from confront.experiments.tanks import print_tank_summary
+
+        return print_tank_summary(summary)
     run = Run(Path(summary["run"]))
     sessions = run.read_table("sessions")
     click.echo(f"\n{summary['name']}: {summary['rounds']} rounds of {summary['scenario']} in "

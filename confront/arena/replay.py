@@ -11,12 +11,18 @@ Replay file (``confront-replay/1``, JSON; ``.json.gz`` is gzip-compressed)::
 
 Every quantity but ``alive`` (0/1), ``turn`` and ``round`` is stored as round(10 * value): 0.1 px, 0.1 deg,
 0.1 energy, 0.1 score point.
+
+Reading is strict: a replay file is at most 64 MB of JSON (also after gunzip), the field is within Robocode's
+400-5000 range per side [BattlefieldSpecification], 1-256 robots, at most 200,000 frames and 3 million robot rows,
+and every list has the length and kind of values the format says; anything else is a :class:`ReplayError`
+naming the file and the problem. GIFs are drawn at most ``MAX_GIF_SIDE`` pixels wide or high.
 """
 
 from __future__ import annotations
 
 import gzip
 import json
+import zlib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -29,6 +35,19 @@ from confront.arena.render import FrameData, draw_frame
 
 FORMAT = "confront-replay/1"
 N_ROBOT_FIELDS = 7  # x, y, heading, gun, radar, energy, alive
+FIELD_RANGE = (400.0, 5000.0)  # Robocode's battlefield width and height [BattlefieldSpecification]
+MAX_ROBOTS = 256
+MAX_FRAMES = 200_000  # a round ends after at most max_turns turns; the longest recorded one has 100,000
+MAX_ROBOT_ROWS = 3_000_000  # frames x robots
+MAX_BULLETS = 100_000  # flying bullets in one frame
+MAX_VALUE = 10**9  # |stored value| (tenths)
+MAX_NAME = 200  # characters of a robot name
+MAX_BYTES = 64 << 20  # a replay's JSON text, also after gunzip
+MAX_GIF_SIDE = 1000  # pixels
+
+
+class ReplayError(ValueError):
+    """A replay file that is not a valid ``confront-replay/1`` file within the limits; one line."""
 
 
 @dataclass
@@ -48,7 +67,16 @@ class Replay:
 
     def __post_init__(self) -> None:
         if len(self.names) != len(self.teams):
-            raise ValueError(f"names has {len(self.names)} entries but teams has {len(self.teams)}")
+            raise ReplayError(f"names has {len(self.names)} entries but teams has {len(self.teams)}")
+        for key, v in (("width", self.width), ("height", self.height)):
+            if not FIELD_RANGE[0] <= v <= FIELD_RANGE[1]:
+                raise ReplayError(f"{key} {v!r} is outside Robocode's {FIELD_RANGE[0]:.0f}-{FIELD_RANGE[1]:.0f}")
+        if not 1 <= len(self.names) <= MAX_ROBOTS:
+            raise ReplayError(f"{len(self.names)} robots: a replay holds 1 to {MAX_ROBOTS}")
+        if any(not isinstance(n, str) or len(n) > MAX_NAME for n in self.names):
+            raise ReplayError(f"robot names must be strings of at most {MAX_NAME} characters")
+        if any(isinstance(t, bool) or not isinstance(t, int) or not 0 <= t < len(self.names) for t in self.teams):
+            raise ReplayError(f"teams must be integers in [0, {len(self.names)})")
 
     @property
     def n_robots(self) -> int:
@@ -136,33 +164,40 @@ class Replay:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Replay:
-        """Read the replay file format."""
-        if d.get("format") != FORMAT:
-            raise ValueError(f"replay format must be {FORMAT!r}, got {d.get('format')!r}")
-        n, names = int(d["n_frames"]), list(d["names"])
-        r = len(names)
-        rob = np.asarray(d["robots"], dtype=np.float64)
-        if rob.size != n * r * N_ROBOT_FIELDS:
-            raise ValueError(f"replay robots has {rob.size} values, expected {n * r * N_ROBOT_FIELDS}")
-        rob = rob.reshape(n, r, N_ROBOT_FIELDS)
+    def from_dict(cls, d: Any) -> Replay:
+        """Read the replay file format; anything outside it or its limits is a :class:`ReplayError`."""
+        if not isinstance(d, dict) or d.get("format") != FORMAT:
+            got = d.get("format") if isinstance(d, dict) else type(d).__name__
+            raise ReplayError(f"replay format must be {FORMAT!r}, got {str(got)[:60]!r}")
+        missing = [k for k in ("width", "height", "names", "teams", "n_frames", "turn", "round", "robots", "bullets")
+                   if k not in d]
+        if missing:
+            raise ReplayError(f"replay lacks the keys {', '.join(missing)}")
+        width, height = _number(d, "width"), _number(d, "height")
+        names, teams = d["names"], d["teams"]
+        if not isinstance(names, list) or not isinstance(teams, list):
+            raise ReplayError("replay names and teams must be lists")
+        n, r = _count(d, "n_frames", 1, MAX_FRAMES), len(names)
+        if not 1 <= r <= MAX_ROBOTS or n * r > MAX_ROBOT_ROWS:
+            raise ReplayError(f"{n} frames of {r} robots: a replay holds 1 to {MAX_ROBOTS} robots and at most "
+                              f"{MAX_ROBOT_ROWS} robot rows")
+        rep = cls(width=width, height=height, names=list(names), teams=list(teams),
+                  scenario=str(d.get("scenario", ""))[:MAX_NAME])
+        rep.turn, rep.round = _ints(d, "turn", n).tolist(), _ints(d, "round", n).tolist()
+        rob = _ints(d, "robots", n * r * N_ROBOT_FIELDS).astype(np.float64).reshape(n, r, N_ROBOT_FIELDS)
         rob[..., :6] /= 10.0
-        scores = None
+        rep.robots = list(rob)
+        bullets = d["bullets"]
+        if not isinstance(bullets, list) or len(bullets) != n:
+            raise ReplayError(f"replay bullets must be a list of {n} frames")
+        rep.bullets = []
+        for i, b in enumerate(bullets):
+            if not isinstance(b, list) or len(b) % 3 or len(b) > 3 * MAX_BULLETS:
+                raise ReplayError(f"replay bullets of frame {i} must be x, y, power triples (at most {MAX_BULLETS})")
+            rep.bullets.append(_ints({"b": b}, "b", len(b)).astype(np.float64).reshape(-1, 3) / 10.0)
         if d.get("scores") is not None:
-            s = np.asarray(d["scores"], dtype=np.float64).reshape(n, r) / 10.0
-            scores = list(s)
-        return cls(
-            width=float(d["width"]),
-            height=float(d["height"]),
-            names=names,
-            teams=[int(t) for t in d["teams"]],
-            scenario=str(d.get("scenario", "")),
-            turn=[int(t) for t in d["turn"]],
-            round=[int(t) for t in d["round"]],
-            robots=list(rob),
-            bullets=[np.asarray(b, dtype=np.float64).reshape(-1, 3) / 10.0 for b in d["bullets"]],
-            scores=scores,
-        )
+            rep.scores = list(_ints(d, "scores", n * r).astype(np.float64).reshape(n, r) / 10.0)
+        return rep
 
     def save(self, path: str | Path) -> Path:
         """Write the replay as compact JSON (gzip when the name ends in .gz)."""
@@ -173,6 +208,31 @@ class Replay:
         else:
             p.write_text(text)
         return p
+
+
+def _number(d: dict[str, Any], key: str) -> float:
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        raise ReplayError(f"replay {key} must be a number, got {str(v)[:60]!r}")
+    return float(v)
+
+
+def _count(d: dict[str, Any], key: str, lo: int, hi: int) -> int:
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
+        raise ReplayError(f"replay {key} must be an integer in [{lo}, {hi}], got {str(v)[:60]!r}")
+    return v
+
+
+def _ints(d: dict[str, Any], key: str, size: int) -> np.ndarray:
+    """``d[key]``: a flat list of ``size`` integers within +-MAX_VALUE."""
+    v = d[key]
+    if not isinstance(v, list) or len(v) != size:
+        n = len(v) if isinstance(v, list) else type(v).__name__
+        raise ReplayError(f"replay {key} must be a list of {size} integers, got {n}")
+    if not all(type(x) is int and -MAX_VALUE <= x <= MAX_VALUE for x in v):
+        raise ReplayError(f"replay {key} must hold integers within +-{MAX_VALUE}")
+    return np.asarray(v, dtype=np.int64)
 
 
 def record_frame(replay: Replay, arena: Any, b: int = 0) -> None:
@@ -197,12 +257,24 @@ def new_replay(arena: Any, names: list[str] | None = None) -> Replay:
 
 
 def load_replay(path: str | Path) -> Replay:
-    """Read a replay file (.json or .json.gz)."""
+    """Read a replay file (.json or .json.gz); a file that is not a valid replay within the limits (see the
+    module docstring) is a :class:`ReplayError` naming it."""
     p = Path(path)
-    raw = p.read_bytes()
-    if p.name.endswith(".gz"):
-        raw = gzip.decompress(raw)
-    return Replay.from_dict(json.loads(raw))
+    try:
+        with p.open("rb") as fh:
+            if p.name.endswith(".gz"):
+                with gzip.GzipFile(fileobj=fh) as gz:
+                    raw = gz.read(MAX_BYTES + 1)
+            else:
+                raw = fh.read(MAX_BYTES + 1)
+        if len(raw) > MAX_BYTES:
+            raise ReplayError(f"it holds more than {MAX_BYTES >> 20} MB of JSON")
+        return Replay.from_dict(json.loads(raw))
+    except ReplayError as exc:
+        raise ReplayError(f"replay {str(p)!r}: {exc}") from None
+    except (OSError, EOFError, ValueError, RecursionError, zlib.error) as exc:  # gzip, JSON, Unicode errors
+        why = str(exc).splitlines()[0][:200] if str(exc).strip() else type(exc).__name__
+        raise ReplayError(f"replay {str(p)!r} cannot be read: {why}") from None
 
 
 def _frame_indices(n: int, max_frames: int | None, every: int) -> list[int]:
@@ -222,9 +294,11 @@ def write_gif(
     fps: float = 30.0,
     max_frames: int | None = 600,
 ) -> Path:
-    """Render the replay to an animated GIF (every ``every``-th frame, at most ``max_frames``)."""
+    """Render the replay to an animated GIF (every ``every``-th frame, at most ``max_frames``; ``scale`` lowered
+    so that no side exceeds ``MAX_GIF_SIDE`` pixels)."""
     if len(replay) == 0:
         raise ValueError("replay has no frames")
+    scale = min(scale, MAX_GIF_SIDE / max(replay.width, replay.height))
     idx = _frame_indices(len(replay), max_frames, every)
     images = [
         Image.fromarray(draw_frame(replay.frame(i), replay.width, replay.height, scale)).quantize(64)

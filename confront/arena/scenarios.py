@@ -56,8 +56,8 @@ class Scenario:
             raise ValueError(f"teams must be a non-empty list of positive sizes, got {self.teams!r}")
         if len(self.teams) < 2 and self.teams[0] < 2:
             raise ValueError(f"teams={self.teams!r}: a battle needs at least two robots")
-        if self.width < 400 or self.height < 400:
-            raise ValueError(f"width/height must be at least 400, got {self.width}x{self.height}")
+        if not (400 <= self.width <= 5000 and 400 <= self.height <= 5000):  # [BattlefieldSpecification]
+            raise ValueError(f"width/height must be in Robocode's 400-5000, got {self.width}x{self.height}")
         if not 0.1 <= self.gun_cooling_rate <= 0.7:
             raise ValueError(f"gun_cooling_rate must be in [0.1, 0.7], got {self.gun_cooling_rate}")
         if self.inactivity_time < 0:

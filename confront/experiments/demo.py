@@ -20,6 +20,11 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
         extra.append(f"train.rounds={rounds}")
     if seed is not None:
         extra.append(f"train.seed={seed}")
+    base = load_experiment("demo", tuple(overrides))
+    if rounds is not None and rounds < base.train.session_rounds:  # --rounds 8: sessions of 8 rounds, said aloud
+        extra.append(f"train.session_rounds={rounds}")
+        click.echo(f"note: --rounds {rounds} is below the demo's session of {base.train.session_rounds} rounds; "
+                   f"sessions of {rounds} rounds", err=True)
     cfg = load_experiment("demo", tuple(extra))
     out = out or Path("runs") / new_run_name("demo")
     click.echo(f"confront demo: {cfg.description}")

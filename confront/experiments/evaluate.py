@@ -217,6 +217,8 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
 def export_cli(run: Path, out: Path, name: str | None) -> None:
     from confront.engine.export import export_robot
 
+    if out.exists() and not out.is_dir() and out.suffix != ".jar":
+        raise FileExistsError(f"--out {out} is an existing file: give a robots folder or a .jar path")
     cfg = _run_config(run)
     learner, _ = load_model(run)
     folder = export_robot(exported_policy(learner, cfg), out)

@@ -76,8 +76,9 @@ class OpponentSection:
 class LearnerSection:
     """The learning team's method (paper §3-4; Table 2)."""
 
-    kind: Literal["dmnn", "ssaq", "random"] = field(
-        "dmnn", doc="dmnn (§4), ssaq (tabular, §3), or random: uniform moves, a reference that never learns")
+    kind: Literal["dmnn", "ssaq", "random", "ppo"] = field(
+        "dmnn", doc="dmnn (§4), ssaq (tabular, §3), random: uniform moves, a reference that never learns, or ppo: "
+        "the recommended shared-policy actor-critic on the tank view (sections tank, ppo, league)")
     learning_rate: Literal["fuzzy", "fixed"] = field("fuzzy", doc="RL learning rate: fuzzy (Eq. 11-17) or fixed alpha")
     alpha: float = field(0.1, gt=0.0, le=1.0, doc="fixed RL learning rate (Table 2: 0.1)")
     gamma: float = field(0.9, ge=0.0, le=1.0, doc="discount (Table 2: 0.9)")
@@ -107,6 +108,67 @@ class TransferSection:
 
 
 @dataclass
+class TankSection:
+    """What a PPO tank sees and chooses (confront.arena.tank): finer moves, fire power or hold, target slot."""
+
+    decision_turns: int = field(5, ge=1, le=100, doc="T: turns each tank action is held")
+    distances: tuple[float, ...] = field((-150.0, -50.0, 0.0, 50.0, 150.0), ge=-1000, le=1000,
+                                         doc="move distances, px (+ ahead)")
+    turns_deg: tuple[float, ...] = field((-90.0, -30.0, 0.0, 30.0, 90.0), ge=-360, le=360,
+                                         doc="body turns, degrees (+ clockwise)")
+    fire_powers: tuple[float, ...] = field((0.0, 1.0, 2.0, 3.0), ge=0.0, le=3.0, doc="bullet powers, 0 = hold fire")
+    enemy_slots: int = field(4, ge=1, le=16, doc="K nearest scanned enemies in the view (and target choices)")
+    mate_slots: int = field(3, ge=0, le=16, doc="M nearest team-mates in the view")
+    lead: Literal["none", "linear"] = field("linear", doc="gun lead of the fixed controller")
+    reward: Literal["score", "eq35"] = field("score", doc="team's Robocode score margin per turn, or Eq. 35")
+
+
+@dataclass
+class PPOSection:
+    """PPO hyper-parameters (confront.learning.ppo)."""
+
+    hidden: int = field(128, ge=1, le=4096)
+    lr: float = field(3e-4, gt=0.0, le=1.0)
+    rollout_steps: int = field(32, ge=1, le=4096)
+    epochs: int = field(4, ge=1, le=100)
+    minibatches: int = field(4, ge=1, le=1024)
+    gamma: float = field(0.99, ge=0.0, le=1.0, doc="discount per decision")
+    gae_lambda: float = field(0.95, ge=0.0, le=1.0)
+    clip: float = field(0.2, gt=0.0, le=10.0)
+    ent_coef: float = field(0.01, ge=0.0, le=10.0)
+    vf_coef: float = field(0.5, ge=0.0, le=100.0)
+    max_grad_norm: float = field(0.5, gt=0.0)
+    reward_scale: float = field(0.01, gt=0.0, doc="score points -> reward units")
+    team_critic: bool = field(True, doc="the critic also sees the mean view of the tank's team (MAPPO-style)")
+
+
+@dataclass
+class LeagueSection:
+    """The PPO opponents: battles of each kind side by side, every rollout."""
+
+    opponents: tuple[str, ...] = field(
+        ("1v1:SittingDuck", "1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Fire", "1v1:Corners",
+         "1v1:Crazy", "1v1:dodge", "1v1:self", "4v4:SpinBot", "4v4:Walls", "4v4:Tracker", "4v4:RamFire",
+         "4v4:Crazy", "4v4:td", "4v4:dodge", "4v4:self"),
+        doc="SCENARIO:OPPONENT entries: a scripted robot (a team of it), td, random, dodge, or self (snapshots)")
+    battles: int = field(8, ge=1, le=4096, doc="battles per entry")
+    snapshot_every: int = field(20, ge=1, doc="updates between self-play snapshots")
+    snapshots: int = field(5, ge=1, le=100, doc="snapshots kept; self-play battles sample one per update")
+
+    def __post_init__(self) -> None:
+        from confront.arena.scenarios import scenario_names
+
+        for e in self.opponents:
+            scen, _, opp = e.partition(":")
+            if scen not in scenario_names() or opp not in (*SCRIPTED_BOTS, "td", "random", "dodge", "self"):
+                raise ValueError(f"league.opponents entry {e!r} is not allowed: use SCENARIO:OPPONENT with a "
+                                 f"scenario of {', '.join(scenario_names())} and an opponent of "
+                                 f"{', '.join(SCRIPTED_BOTS)}, td, random, dodge, self")
+        if not self.opponents:
+            raise ValueError("league.opponents must not be empty")
+
+
+@dataclass
 class TrainSection:
     """Length, sessions, seeds, checkpoints."""
 
@@ -128,6 +190,9 @@ class ExperimentConfig:
     learner: LearnerSection = field(default_factory=LearnerSection)
     transfer: TransferSection = field(default_factory=TransferSection)
     train: TrainSection = field(default_factory=TrainSection)
+    tank: TankSection = field(default_factory=TankSection)
+    ppo: PPOSection = field(default_factory=PPOSection)
+    league: LeagueSection = field(default_factory=LeagueSection)
 
     def __post_init__(self) -> None:
         if not RUN_NAME.fullmatch(self.name):

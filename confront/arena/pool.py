@@ -1,0 +1,156 @@
+"""An opponent pool: several :class:`~confront.arena.smdp.TeamBattleEnv` batches stepped as one set of agents.
+
+``PoolEnv(entries, config, seed)``: one env per :class:`PoolEntry` (a scenario, its opponents, how many
+battles). Team 0's learning tanks of every battle of every entry are the pool's agents, in a fixed order
+(entry, battle, robot): ``N = sum(battles * team-0 size)``. Observations are the learners' feature vectors
+(the tank view has one length for every scenario, so 1v1 and 4v4 battles share a policy).
+
+``step(actions (N,) ints)`` steps every env once (T turns) and returns a :class:`PoolStep`: next observations
+(N, F) float32 (after auto-reset, a new round's first), per-step rewards (N,) (the sum of the step's per-turn
+rewards), ``done`` (N,) (the tank died or its round ended: nothing to bootstrap), ``active`` (N,) (it was
+alive at the start of the step: the transition counts), and the rounds that ended (entry, score ours/theirs).
+
+Opponents driven by the caller (``"td"`` in a scenario's opponents: a TD team, random moves, a dodge, a
+snapshot of the policy) get their actions from the entry's ``policy(discrete (n,), features (n, F), rng)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .smdp import LEARNER, SMDPConfig, TeamBattleEnv
+
+__all__ = ["PoolEntry", "PoolEnv", "PoolStep", "OpponentPolicy"]
+
+OpponentPolicy = Callable[[np.ndarray, np.ndarray, np.random.Generator], np.ndarray]
+
+
+@dataclass
+class PoolEntry:
+    """One kind of battle in the pool: ``name`` labels its metrics (e.g. ``1v1/SpinBot``)."""
+
+    name: str
+    scenario: str
+    opponents: str  # a scripted robot name for every opponent, or "td" (caller-driven: ``policy``)
+    battles: int
+    policy: OpponentPolicy | None = None
+    opponent_actions: str = "same"  # the caller-driven opponents' action space: "same" or "paper"
+
+    def __post_init__(self) -> None:
+        if self.battles < 1:
+            raise ValueError(f"pool entry {self.name!r}: battles must be >= 1, got {self.battles}")
+        if (self.opponents == LEARNER) != (self.policy is not None):
+            raise ValueError(f"pool entry {self.name!r}: caller-driven opponents ('td') need a policy, "
+                             "scripted ones none")
+
+
+@dataclass
+class PoolStep:
+    """What :meth:`PoolEnv.step` returns (see the module docstring)."""
+
+    obs: np.ndarray  # (N, F) float32
+    reward: np.ndarray  # (N,) float64
+    done: np.ndarray  # (N,) bool
+    active: np.ndarray  # (N,) bool
+    rounds: list[dict[str, float | str | bool]] = field(default_factory=list)
+
+
+class PoolEnv:
+    """Every entry's battles in one agent set; see the module docstring."""
+
+    def __init__(self, entries: list[PoolEntry], config: SMDPConfig, seed: int = 0) -> None:
+        if not entries:
+            raise ValueError("the pool needs at least one entry")
+        names = [e.name for e in entries]
+        if len(set(names)) != len(names):
+            raise ValueError(f"pool entry names must be unique, got {names}")
+        self.entries = entries
+        self.envs = [TeamBattleEnv(e.scenario, n_battles=e.battles, seed=seed * 1000 + k, opponents=e.opponents,
+                                   config=config, opponent_actions=e.opponent_actions)  # type: ignore[arg-type]
+                     for k, e in enumerate(entries)]
+        self.ours = [env.team_ids() == 0 for env in self.envs]
+        self.theirs = [env.learner & (env.team_ids() != 0) for env in self.envs]
+        sizes = [env.n_battles * int(o.sum()) for env, o in zip(self.envs, self.ours, strict=True)]
+        self.bounds = np.concatenate([[0], np.cumsum(sizes)])
+        self.n_agents = int(self.bounds[-1])
+        self.n_features = self.envs[0].n_features
+        if any(env.n_features != self.n_features for env in self.envs):
+            raise ValueError("pool entries must share one observation length (use the tank view)")
+        self.n_actions = self.envs[0].n_actions
+        self.action_dims = self.envs[0].action_dims
+        # agent -> its team (entry, battle): a team critic pools over these groups
+        groups, entry_of, g0 = [], [], 0
+        for k, (env, o) in enumerate(zip(self.envs, self.ours, strict=True)):
+            groups.append(g0 + np.repeat(np.arange(env.n_battles), int(o.sum())))
+            entry_of.append(np.full(env.n_battles * int(o.sum()), k))
+            g0 += env.n_battles
+        self.group = np.concatenate(groups)
+        self.n_groups = g0
+        self.entry_of = np.concatenate(entry_of)
+        self.rng = np.random.default_rng([seed, 17])
+        self._disc: list[np.ndarray] = []
+        self._feats: list[np.ndarray] = []
+
+    def reset(self) -> np.ndarray:
+        """New battles in every env: the agents' first observations (N, F)."""
+        self._disc, self._feats = [], []
+        for env in self.envs:
+            d, f = env.reset()
+            self._disc.append(d)
+            self._feats.append(f)
+        return self._gather(self._feats)
+
+    def _gather(self, feats: list[np.ndarray]) -> np.ndarray:
+        return np.concatenate([f[:, o].reshape(-1, f.shape[-1]) for f, o in zip(feats, self.ours, strict=True)])
+
+    def step(self, actions: np.ndarray) -> PoolStep:
+        """Every env one SMDP step with the agents' ``actions`` (N,)."""
+        a = np.asarray(actions, dtype=np.int64)
+        if a.shape != (self.n_agents,):
+            raise ValueError(f"actions must have shape ({self.n_agents},), got {a.shape}")
+        obs, rew, done, active, rounds = [], [], [], [], []
+        for k, (entry, env) in enumerate(zip(self.entries, self.envs, strict=True)):
+            ours, theirs = self.ours[k], self.theirs[k]
+            full = np.zeros((env.n_battles, env.n_robots), dtype=np.int64)
+            full[:, ours] = a[self.bounds[k]:self.bounds[k + 1]].reshape(env.n_battles, -1)
+            if entry.policy is not None:
+                d, f = self._disc[k][:, theirs], self._feats[k][:, theirs]
+                full[:, theirs] = np.asarray(entry.policy(d.reshape(-1), f.reshape(-1, f.shape[-1]), self.rng),
+                                             dtype=np.int64).reshape(env.n_battles, -1)
+            res = env.step(full)
+            self._disc[k], self._feats[k] = res.discrete, res.features
+            obs.append(res.features[:, ours].reshape(-1, res.features.shape[-1]))
+            rew.append(res.rewards[:, ours].sum(axis=2).reshape(-1))
+            done.append(res.terminated[:, ours].reshape(-1))
+            active.append(res.active[:, ours].reshape(-1))
+            if res.round_end is not None:
+                end = res.round_end
+                for b in np.flatnonzero(end.mask):
+                    s = end.score[b].sum(axis=1)
+                    o, t = float(s[ours].sum()), float(s[~ours].sum())
+                    rounds.append({"opponent": entry.name, "battle": int(b), "score_ours": o, "score_theirs": t,
+                                   "share": o / (o + t) if o + t > 0 else 0.5, "turns": int(end.turns[b]),
+                                   "won": bool(end.decided[b] and end.alive[b][ours].any())})
+        return PoolStep(np.concatenate(obs), np.concatenate(rew), np.concatenate(done), np.concatenate(active),
+                        rounds)
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Every env's state and the last observations (data only)."""
+        d: dict[str, np.ndarray] = {}
+        for k, env in enumerate(self.envs):
+            d.update({f"env{k}.{n}": v for n, v in env.state_dict().items()})
+            d[f"obs{k}.discrete"], d[f"obs{k}.features"] = self._disc[k], self._feats[k]
+        return d
+
+    def load_state_dict(self, d: dict[str, np.ndarray]) -> np.ndarray:
+        """Restore :meth:`state_dict`; returns the agents' current observations."""
+        self._disc, self._feats = [], []
+        for k, env in enumerate(self.envs):
+            p = f"env{k}."
+            env.load_state_dict({n[len(p):]: v for n, v in d.items() if n.startswith(p)})
+            self._disc.append(np.asarray(d[f"obs{k}.discrete"]))
+            self._feats.append(np.asarray(d[f"obs{k}.features"]))
+        return self._gather(self._feats)

@@ -1,0 +1,460 @@
+"""Training the recommended learner: PPO tanks against a league of opponents in the batched simulator.
+
+    league entries (scenario x opponent) -> PoolEnv (all battles, one call per entry)
+    -> tank views (N, F) -> PPO.act -> joint tank actions (N,) -> PoolEnv.step -> score-margin rewards
+    -> every S steps: PPO.update (GAE, clipped surrogate), metrics, self-play snapshot, checkpoint
+
+Opponents (``league.opponents``, ``SCENARIO:OPPONENT``): a scripted sample robot (in 4v4 a team of four),
+``td`` (the paper's TD team, greedy, paper moves), ``random`` (uniform paper moves), ``dodge`` (a hand-written
+stochastic dodge on the tank view), ``self`` (a snapshot of the policy, sampled from the last few).
+Nothing in a tank's view names its opponent.
+
+Run folder: ``metrics/rounds.csv`` (one row per round: opponent, scores, share), ``metrics/sessions.csv``,
+``metrics/updates.csv`` and TensorBoard scalars in ``tb/`` (share per opponent, losses, entropy,
+decisions/s), ``model/`` (``model.json`` kind ppo, ``actor.npz``, ``tank.json``), data-only checkpoints
+after every ``train.checkpoint_every`` rounds (at an update boundary: a resumed run is identical).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from confront import checkpoint as ck
+from confront.arena.observe import ObservationConfig
+from confront.arena.pool import PoolEntry, PoolEnv, PoolStep
+from confront.arena.smdp import SMDPConfig
+from confront.arena.tank import OWN_FEATURES, TankSpace
+from confront.experiments.spec import ExperimentConfig
+from confront.learning.ppo import PPO, PPOConfig, Rollout
+from confront.runs import Run
+
+__all__ = ["train_tanks", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "SnapshotPolicy",
+           "save_tank_model", "load_tank_model", "evaluate_tanks"]
+
+
+def tank_space(cfg: ExperimentConfig) -> TankSpace:
+    """The config's tank actions and view."""
+    t = cfg.tank
+    return TankSpace(distances=tuple(t.distances), turns_deg=tuple(t.turns_deg), fire_powers=tuple(t.fire_powers),
+                     enemy_slots=t.enemy_slots, mate_slots=t.mate_slots, lead=t.lead)
+
+
+def smdp_tank_config(cfg: ExperimentConfig) -> SMDPConfig:
+    """The SMDP step of a PPO tank."""
+    return SMDPConfig(turns_per_step=cfg.tank.decision_turns, tank=tank_space(cfg), reward=cfg.tank.reward,
+                      observation=ObservationConfig(sensing="scanned"))
+
+
+def ppo_config(cfg: ExperimentConfig) -> PPOConfig:
+    """The config's PPO section as the learner's."""
+    return PPOConfig(**asdict(cfg.ppo))
+
+
+# -- opponents driven by Python ----------------------------------------------------------------------------------
+
+def random_policy(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Uniform random paper moves."""
+    return rng.integers(0, 4, size=len(disc))
+
+
+def dodge_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
+    """A hand-written stochastic dodge on the tank view: turn the body perpendicular to the nearest known
+    enemy, drive full distance ahead or back at random each step, fire power 2 at it (the tank actions)."""
+    turns = np.radians(np.asarray(space.turns_deg))
+    dists = np.asarray(space.distances)
+    powers = np.asarray(space.fire_powers)
+    far = int(np.argmax(dists)), int(np.argmin(dists))
+    fire = int(np.argmin(np.abs(powers - 2.0)))
+
+    def act(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        o = OWN_FEATURES
+        rel = np.arctan2(feats[:, o + 1], feats[:, o + 2])  # bearing of slot 0 from the heading
+        want = (rel + np.pi / 2 + np.pi) % np.pi - np.pi / 2  # nearest perpendicular: rel -+ 90 deg in [-90, 90)
+        want = (want - np.pi / 2 + np.pi) % (2 * np.pi) - np.pi
+        want = np.where(np.abs(want) > np.pi / 2, want - np.sign(want) * np.pi, want)
+        t = np.argmin(np.abs(turns[None, :] - want[:, None]), axis=1)
+        d = np.where(rng.random(len(disc)) < 0.5, far[0], far[1])
+        f = np.where(feats[:, o] > 0, fire, int(np.argmin(powers)))
+        return np.ravel_multi_index((d, t, f, np.zeros_like(d)), space.dims)
+
+    return act
+
+
+class SnapshotPolicy:
+    """A frozen copy of the actor (NumPy), sampling its actions: the self-play opponent."""
+
+    def __init__(self, dims: tuple[int, ...]) -> None:
+        self.dims = dims
+        self.layers: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def load(self, arrays: dict[str, np.ndarray]) -> None:
+        """Set the weights from ``PPO.actor_arrays()``."""
+        n = sum(1 for k in arrays if k.startswith("w"))
+        self.layers = [(np.asarray(arrays[f"w{i}"]), np.asarray(arrays[f"b{i}"])) for i in range(n)]
+
+    def __call__(self, disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        h = feats.astype(np.float64)
+        for i, (w, b) in enumerate(self.layers):
+            h = h @ w.T + b
+            if i < len(self.layers) - 1:
+                h = np.tanh(h)
+        out = np.zeros(len(h), dtype=np.int64)
+        start = 0
+        for d in self.dims:
+            z = h[:, start:start + d]
+            p = np.exp(z - z.max(axis=1, keepdims=True))
+            p /= p.sum(axis=1, keepdims=True)
+            pick = (rng.random(len(z))[:, None] > np.cumsum(p, axis=1)).sum(axis=1)
+            out = out * d + np.minimum(pick, d - 1)
+            start += d
+        return out
+
+
+def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, progress: bool = False
+               ) -> tuple[PoolEnv, SnapshotPolicy]:
+    """The league as a PoolEnv; the self-play snapshot policy its ``self`` entries share."""
+    space = tank_space(cfg)
+    snap = SnapshotPolicy(space.dims)
+    td = None
+    entries = []
+    for e in cfg.league.opponents:
+        scen, _, opp = e.partition(":")
+        n = battles or cfg.league.battles
+        if opp == "td":
+            if td is None:
+                td = _td_opponent(cfg, progress)
+            entries.append(PoolEntry(e, scen, "td", n, policy=td, opponent_actions="paper"))
+        elif opp == "random":
+            entries.append(PoolEntry(e, scen, "td", n, policy=random_policy, opponent_actions="paper"))
+        elif opp == "dodge":
+            entries.append(PoolEntry(e, scen, "td", n, policy=dodge_policy(space)))
+        elif opp == "self":
+            entries.append(PoolEntry(e, scen, "td", n, policy=snap))
+        else:
+            entries.append(PoolEntry(e, scen, opp, n))
+    return PoolEnv(entries, smdp_tank_config(cfg), seed=seed), snap
+
+
+def _td_opponent(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - returns an OpponentPolicy
+    """The paper's TD team (trained once per seed and cached, as in the paper's experiments), greedy."""
+    from confront.experiments.train import td_team
+
+    learner, _ = td_team(cfg, 4, progress=progress)
+
+    def act(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        return learner.act(disc, rng, explore=False)
+
+    return act
+
+
+# -- models ------------------------------------------------------------------------------------------------------
+
+def _write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Arrays as an uncompressed .npz, written atomically (data only)."""
+    import io
+
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    ck.write_atomic(path, buf.getvalue())
+
+
+def _read_npz(path: Path) -> dict[str, np.ndarray]:
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def save_tank_model(folder: Path, ppo: PPO, cfg: ExperimentConfig, meta: dict[str, Any]) -> None:
+    """``model.json`` (kind ppo), ``actor.npz`` (w0, b0, ... as (out, in)), ``tank.json`` (actions, view,
+    controller), ``ppo.npz`` (the whole learner, to continue training)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    _write_npz(folder / "actor.npz", ppo.actor_arrays())
+    _write_npz(folder / "ppo.npz", ppo.state_dict())
+    from confront.arena.control import ControlConfig
+
+    c = ControlConfig()
+    tank = {**asdict(tank_space(cfg)), "step_turns": cfg.tank.decision_turns, "hidden": cfg.ppo.hidden,
+            "team_critic": cfg.ppo.team_critic, "radar_overshoot": c.radar_overshoot,
+            "aim_tolerance": c.aim_tolerance, "n_features": ppo.n_features, "dims": list(ppo.dims)}
+    ck.write_atomic(folder / "tank.json", json.dumps(tank, indent=1, sort_keys=True).encode())
+    info = {"format": "confront-model/1", "kind": "ppo", "observation": "tank", "n_actions": ppo.n_actions, **meta}
+    ck.write_atomic(folder / "model.json", json.dumps(info, indent=1, sort_keys=True).encode())
+
+
+def load_tank_model(folder: str | Path, cfg: ExperimentConfig) -> PPO:
+    """The PPO learner of a run folder (or its ``model/``)."""
+    p = Path(folder)
+    if (p / "model").is_dir():
+        p = p / "model"
+    space = tank_space(cfg)
+    ppo = PPO(space.n_features, space.dims, ppo_config(cfg))
+    try:
+        ppo.load_state_dict(_read_npz(p / "ppo.npz"))
+    except (OSError, ValueError, KeyError) as exc:
+        raise ck.CheckpointError(f"model {p} cannot be read: {exc}") from None
+    return ppo
+
+
+# -- the loop ----------------------------------------------------------------------------------------------------
+
+class TankTrainer:
+    """Rollouts over the pool and PPO updates; all state is data (checkpoints resume exactly)."""
+
+    def __init__(self, cfg: ExperimentConfig, progress: bool = False) -> None:
+        self.cfg = cfg
+        self.pool, self.snap = build_pool(cfg, cfg.train.seed, progress=progress)
+        self.ppo = PPO(self.pool.n_features, self.pool.action_dims, ppo_config(cfg), seed=cfg.train.seed)
+        self.snapshots: list[dict[str, np.ndarray]] = []
+        self.obs = self.pool.reset()
+        self.rows: list[dict[str, Any]] = []
+        self.updates: list[dict[str, Any]] = []
+        self.decisions = 0
+        self.elapsed = 0.0
+        self._take_snapshot()
+
+    @property
+    def rounds_done(self) -> int:
+        return len(self.rows)
+
+    def _take_snapshot(self) -> None:
+        self.snapshots.append(self.ppo.actor_arrays())
+        del self.snapshots[: -self.cfg.league.snapshots]
+
+    def _pick_snapshot(self) -> None:
+        self.snap.load(self.snapshots[int(self.pool.rng.integers(len(self.snapshots)))])
+
+    def _critic(self, obs: np.ndarray) -> np.ndarray:
+        return self.ppo.critic_input(obs, self.pool.group, self.pool.n_groups, obs[:, 7] > 0)
+
+    def update(self) -> dict[str, Any]:
+        """One rollout of S steps and one PPO update; returns the update's log row."""
+        t0 = time.perf_counter()
+        c, pool = self.ppo.config, self.pool
+        self._pick_snapshot()
+        s, n = c.rollout_steps, pool.n_agents
+        crit0 = self._critic(self.obs)
+        buf = Rollout(obs=np.zeros((s, n, self.obs.shape[1]), np.float32),
+                      critic=np.zeros((s, n, crit0.shape[1]), np.float32),
+                      heads=np.zeros((s, n, len(self.ppo.dims)), np.int64), logp=np.zeros((s, n), np.float32),
+                      value=np.zeros((s, n), np.float32), reward=np.zeros((s, n)), done=np.zeros((s, n), bool),
+                      active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
+        t_env = 0.0
+        crit = crit0
+        for k in range(s):
+            joint, heads, logp, value = self.ppo.act(self.obs, crit)
+            te = time.perf_counter()
+            st: PoolStep = pool.step(joint)
+            t_env += time.perf_counter() - te
+            buf.obs[k], buf.critic[k], buf.heads[k], buf.logp[k], buf.value[k] = self.obs, crit, heads, logp, value
+            buf.reward[k], buf.done[k], buf.active[k] = st.reward * c.reward_scale, st.done, st.active
+            self.decisions += int(st.active.sum())
+            for r in st.rounds:
+                self.rows.append({"round": len(self.rows) + 1, **r, "decisions": self.decisions})
+            self.obs = st.obs
+            crit = self._critic(self.obs)
+        buf.last_value = self.ppo.values(crit)
+        t_up = time.perf_counter()
+        stats = self.ppo.update(buf)
+        if self.ppo.updates % self.cfg.league.snapshot_every == 0:
+            self._take_snapshot()
+        dt = time.perf_counter() - t0
+        self.elapsed += dt
+        row = {"update": self.ppo.updates, "rounds": self.rounds_done, "decisions": self.decisions,
+               "wall_s": self.elapsed, "decisions_per_s": float(buf.active.sum()) / dt,
+               "env_fraction": t_env / dt, "update_fraction": (time.perf_counter() - t_up) / dt, **stats}
+        for r in self.rows[-200:]:
+            r.setdefault("wall_s", self.elapsed)
+        self.updates.append(row)
+        return row
+
+    # checkpoint state
+    def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        arrays = {f"pool.{k}": v for k, v in self.pool.state_dict().items()}
+        arrays.update({f"ppo.{k}": v for k, v in self.ppo.state_dict().items()})
+        for i, snap in enumerate(self.snapshots):
+            arrays.update({f"snap{i}.{k}": v for k, v in snap.items()})
+        arrays["obs"] = self.obs
+        meta = {"kind": "ppo", "rounds_done": self.rounds_done, "decisions": self.decisions, "rows": self.rows,
+                "updates": self.updates, "elapsed_s": self.elapsed, "snapshots": len(self.snapshots),
+                "pool_rng": ck.rng_state(self.pool.rng)}
+        return arrays, meta
+
+    def load(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None:
+        def sub(prefix: str) -> dict[str, np.ndarray]:
+            return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}
+
+        try:
+            if meta.get("kind") != "ppo":
+                raise ValueError("not a PPO checkpoint")
+            self.pool.load_state_dict(sub("pool."))
+            self.ppo.load_state_dict(sub("ppo."))
+            self.snapshots = [sub(f"snap{i}.") for i in range(int(meta["snapshots"]))]
+            self.obs = np.asarray(arrays["obs"], dtype=np.float32)
+            self.rows, self.updates = list(meta["rows"]), list(meta["updates"])
+            self.decisions, self.elapsed = int(meta["decisions"]), float(meta["elapsed_s"])
+            self.pool.rng = ck.rng_from_state(meta["pool_rng"])
+        except (KeyError, ValueError, TypeError) as exc:
+            raise ck.CheckpointError(f"checkpoint does not fit this run's config: {exc}") from None
+
+
+def share_by_opponent(rows: list[dict[str, Any]]) -> dict[str, float]:
+    """Pooled score share per opponent over ``rows``."""
+    out: dict[str, list[float]] = {}
+    for r in rows:
+        o = out.setdefault(r["opponent"], [0.0, 0.0])
+        o[0] += r["score_ours"]
+        o[1] += r["score_theirs"]
+    return {k: v[0] / (v[0] + v[1]) if v[0] + v[1] > 0 else 0.5 for k, v in out.items()}
+
+
+def tank_sessions(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
+    """Sessions of ``size`` rounds (in the order rounds ended): pooled score ratio, win rate, wall time."""
+    out = []
+    for start in range(0, len(rows) - size + 1, size):
+        chunk = rows[start:start + size]
+        o = sum(r["score_ours"] for r in chunk)
+        t = sum(r["score_theirs"] for r in chunk)
+        out.append({"session": len(out) + 1, "rounds": len(chunk), "score_ours": o, "score_theirs": t,
+                    "score_ratio": o / (o + t) if o + t > 0 else 0.5,
+                    "win_rate": sum(r["won"] for r in chunk) / len(chunk),
+                    "decisions": chunk[-1]["decisions"], "wall_s": chunk[-1].get("wall_s", 0.0)})
+    return out
+
+
+def train_tanks(cfg: ExperimentConfig, run: Run, resume: bool = False, progress: bool = True) -> dict[str, Any]:
+    """Train PPO tanks into ``run`` (or continue it); write metrics, model, plots; return the summary."""
+    from torch.utils.tensorboard import SummaryWriter
+    from tqdm import tqdm
+
+    trainer = TankTrainer(cfg, progress=progress)
+    if resume:
+        latest = ck.latest(run.checkpoints)
+        if latest is not None:
+            arrays, meta = ck.load(latest)
+            trainer.load(arrays, meta)
+            if progress:
+                click.echo(f"resuming {run.path} from {latest.name} ({trainer.rounds_done} rounds done)")
+    tc = cfg.train
+    writer = SummaryWriter(str(run.path / "tb"))
+    bar = tqdm(total=tc.rounds, initial=min(trainer.rounds_done, tc.rounds), desc=f"{cfg.name} ppo", unit="round",
+               disable=not progress, dynamic_ncols=True)
+    next_ckpt = (trainer.rounds_done // tc.checkpoint_every + 1) * tc.checkpoint_every
+    try:
+        while trainer.rounds_done < tc.rounds:
+            row = trainer.update()
+            step = row["decisions"]
+            recent = trainer.rows[-200:]
+            for name, v in share_by_opponent(recent).items():
+                writer.add_scalar(f"share/{name}", v, step)
+            for k in ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance",
+                      "decisions_per_s"):
+                writer.add_scalar(f"train/{k}", row[k], step)
+            o = sum(r["score_ours"] for r in recent)
+            t = sum(r["score_theirs"] for r in recent)
+            bar.update(min(trainer.rounds_done, tc.rounds) - bar.n)
+            bar.set_postfix(share=f"{o / (o + t) if o + t else 0.5:.3f}", dps=f"{row['decisions_per_s']:,.0f}",
+                            refresh=False)
+            if trainer.rounds_done >= next_ckpt and trainer.rounds_done < tc.rounds:
+                arrays, meta = trainer.state()
+                ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
+                next_ckpt = (trainer.rounds_done // tc.checkpoint_every + 1) * tc.checkpoint_every
+    finally:
+        bar.close()
+        writer.close()
+    rows = trainer.rows
+    sessions = tank_sessions(rows, tc.session_rounds)
+    run.write_table("rounds", rows)
+    run.write_table("sessions", sessions)
+    run.write_table("updates", trainer.updates)
+    save_tank_model(run.path / "model", trainer.ppo, cfg, {"trained_rounds": len(rows)})
+    figures = _plots(run, rows, sessions, cfg)
+    tail = rows[-min(200, len(rows)):]
+    o, t = sum(r["score_ours"] for r in tail), sum(r["score_theirs"] for r in tail)
+    summary = {
+        "name": cfg.name, "run": str(run.path), "learner": "ppo", "scenario": "league", "rounds": len(rows),
+        "sessions": len(sessions), "decisions": trainer.decisions, "updates": trainer.ppo.updates,
+        "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
+        "first_session_ratio": sessions[0]["score_ratio"] if sessions else math.nan,
+        "last_session_ratio": sessions[-1]["score_ratio"] if sessions else math.nan,
+        "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
+        "share_by_opponent_last": share_by_opponent(tail),
+        "decisions_per_s": trainer.decisions / max(trainer.elapsed, 1e-9), "wall_time_s": trainer.elapsed,
+        "figures": [str(f) for f in figures],
+    }
+    run.write_summary(summary)
+    return summary
+
+
+def _plots(run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]], cfg: ExperimentConfig
+           ) -> list[Path]:
+    from confront.experiments.plots import plot_curves
+
+    if not sessions:
+        return []
+    figs = [plot_curves({cfg.name: np.array([s["score_ratio"] for s in sessions])}, run.plots / "score_ratio.png",
+                        ylabel="score share", title=f"{cfg.name}: score share per session of "
+                        f"{cfg.train.session_rounds} rounds (all opponents)", hline=0.5)]
+    per: dict[str, list[float]] = {}
+    window = max(10, cfg.train.session_rounds // 4)
+    for name in sorted({r["opponent"] for r in rows}):
+        sub = [r for r in rows if r["opponent"] == name]
+        per[name] = [share_by_opponent(sub[i:i + window])[name] for i in range(0, len(sub) - window + 1, window)]
+    n = min((len(v) for v in per.values()), default=0)
+    if n > 1:
+        figs.append(plot_curves({k: np.array(v[:n]) for k, v in per.items()}, run.plots / "share_by_opponent.png",
+                                ylabel="score share", title=f"{cfg.name}: share per opponent ({window}-round windows)",
+                                hline=0.5))
+    return figs
+
+
+def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_000,
+                   opponents: tuple[str, ...] | None = None, battles: int = 16) -> dict[str, dict[str, float]]:
+    """Greedy play against each league entry for ``rounds`` rounds: share (pooled) and win rate per entry."""
+    from dataclasses import replace
+
+    league = replace(cfg.league, opponents=opponents or cfg.league.opponents)
+    ecfg = replace(cfg, league=league)
+    pool, snap = build_pool(ecfg, seed, battles=battles)
+    snap.load(ppo.actor_arrays())
+    obs = pool.reset()
+    rows: list[dict[str, Any]] = []
+    done = {e.name: 0 for e in pool.entries}
+    while min(done.values()) < rounds:
+        joint, *_ = ppo.act(obs, explore=False)
+        st = pool.step(joint)
+        for r in st.rounds:
+            if done[r["opponent"]] < rounds:
+                rows.append(r)
+                done[r["opponent"]] += 1
+        obs = st.obs
+    shares = share_by_opponent(rows)
+    return {k: {"share": shares[k], "win_rate": float(np.mean([r["won"] for r in rows if r["opponent"] == k])),
+                "rounds": done[k]} for k in shares}
+
+
+def print_tank_summary(summary: dict[str, Any]) -> None:
+    """The results table of a PPO run, for the terminal: sessions, then the share per opponent."""
+    run = Run(Path(summary["run"]))
+    sessions = run.read_table("sessions")
+    click.echo(f"\n{summary['name']}: {summary['rounds']} rounds against the league in {summary['wall_time_s']:.1f} s "
+               f"({summary['decisions']:,} decisions, {summary['decisions_per_s']:,.0f}/s)")
+    if sessions:
+        click.echo("\n| session | decisions | score ours | score theirs | score share | win rate |")
+        click.echo("|---:|---:|---:|---:|---:|---:|")
+        step = max(1, len(sessions) // 10)
+        for s in sessions[::step] + ([sessions[-1]] if (len(sessions) - 1) % step else []):
+            click.echo(f"| {s['session']} | {int(float(s['decisions'])):,} | {float(s['score_ours']):.0f} | "
+                       f"{float(s['score_theirs']):.0f} | {float(s['score_ratio']):.3f} | {float(s['win_rate']):.2f} |")
+    click.echo(f"\nscore share over the last {summary['final_window_rounds']} rounds, per opponent:")
+    for name, v in sorted(summary["share_by_opponent_last"].items()):
+        click.echo(f"  {name:<18} {v:.3f}")
+    click.echo(f"all: {summary['final_score_ratio']:.3f} (first session {summary['first_session_ratio']:.3f}, "
+               f"last {summary['last_session_ratio']:.3f})")
+    click.echo(f"run folder: {summary['run']}  (plots/, metrics/, model/, tb/, summary.json)")

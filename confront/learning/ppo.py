@@ -1,0 +1,299 @@
+"""PPO with one policy shared by every tank and a team critic (MAPPO-style), CleanRL-style in one file.
+
+The recommended learner (beyond the paper). Every learning tank of every battle is an agent of one shared
+actor (parameter sharing, as the paper's §4.2); the critic sees the tank's own view and the mean view of
+its team's living tanks (``team_critic``), so a team's value is learned from the whole team's observations.
+
+Actions are factorised: one categorical head per action dimension (move distance, body turn, fire power,
+target slot: :class:`confront.arena.tank.TankSpace`), the joint action is their mixed-radix index.
+
+One update (Schulman et al. 2017; the 37 details of Huang et al. 2022 as in CleanRL's ppo.py):
+
+    rollout of S steps over N agents  ->  GAE(gamma, lambda) advantages over each agent's stream
+    (a stream ends where ``done``; steps where an agent was not ``active`` (dead) carry no loss)
+    -> E epochs of M minibatches: clipped surrogate, clipped value loss, entropy bonus, grad-norm clip
+
+Arrays in, arrays out: :meth:`PPO.act` takes (N, F) float32 observations; :meth:`PPO.update` a
+:class:`Rollout`. Parameters, optimiser moments and the sampling generator are data (:meth:`state_dict`),
+so a checkpoint resumes exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import nn
+
+__all__ = ["PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
+
+
+@dataclass(frozen=True)
+class PPOConfig:
+    """PPO hyper-parameters (defaults: CleanRL's, with a larger batch for many agents)."""
+
+    hidden: int = 128
+    lr: float = 3e-4
+    rollout_steps: int = 32  # S
+    epochs: int = 4  # E
+    minibatches: int = 4  # M
+    gamma: float = 0.99  # per decision (T turns)
+    gae_lambda: float = 0.95
+    clip: float = 0.2
+    ent_coef: float = 0.01
+    vf_coef: float = 0.5
+    max_grad_norm: float = 0.5
+    reward_scale: float = 0.01  # score points -> reward units
+    team_critic: bool = True
+    threads: int = 1  # torch threads: 1 beside the simulator's threads (more spin-waits on a busy machine)
+
+    def __post_init__(self) -> None:
+        for name in ("hidden", "rollout_steps", "epochs", "minibatches"):
+            v = getattr(self, name)
+            if not isinstance(v, int) or v < 1:
+                raise ValueError(f"ppo.{name} must be an integer >= 1, got {v!r}")
+        for name, lo, hi in (("gamma", 0, 1), ("gae_lambda", 0, 1), ("clip", 0, 10)):
+            v = getattr(self, name)
+            if not lo <= v <= hi:
+                raise ValueError(f"ppo.{name} must be in [{lo}, {hi}], got {v!r}")
+        for name in ("lr", "reward_scale", "max_grad_norm"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"ppo.{name} must be > 0, got {getattr(self, name)!r}")
+
+
+def _layer(n_in: int, n_out: int, gain: float) -> nn.Linear:
+    """Orthogonal weights, zero bias (CleanRL's layer_init)."""
+    layer = nn.Linear(n_in, n_out)
+    nn.init.orthogonal_(layer.weight, gain)
+    nn.init.zeros_(layer.bias)
+    return layer
+
+
+class ActorCritic(nn.Module):
+    """Actor: F -> H -> H -> sum(dims) logits (tanh); critic: (F or 2F) -> H -> H -> 1 (tanh)."""
+
+    def __init__(self, n_features: int, dims: tuple[int, ...], hidden: int, team_critic: bool) -> None:
+        super().__init__()
+        self.dims = tuple(int(d) for d in dims)
+        g = float(np.sqrt(2))
+        self.actor = nn.Sequential(_layer(n_features, hidden, g), nn.Tanh(), _layer(hidden, hidden, g), nn.Tanh(),
+                                   _layer(hidden, sum(self.dims), 0.01))
+        n_crit = 2 * n_features if team_critic else n_features
+        self.critic = nn.Sequential(_layer(n_crit, hidden, g), nn.Tanh(), _layer(hidden, hidden, g), nn.Tanh(),
+                                    _layer(hidden, 1, 1.0))
+
+    def heads(self, obs: torch.Tensor) -> list[torch.Tensor]:
+        """Per-head log-probabilities (N, d_h)."""
+        return [torch.log_softmax(z, dim=-1) for z in torch.split(self.actor(obs), self.dims, dim=-1)]
+
+    def value(self, critic_in: torch.Tensor) -> torch.Tensor:
+        """V (N,)."""
+        return self.critic(critic_in).squeeze(-1)
+
+
+def team_mean(obs: np.ndarray, group: np.ndarray, n_groups: int, alive: np.ndarray) -> np.ndarray:
+    """(N, F) mean observation of each agent's team (its ``group``), over living agents (all if none lives)."""
+    w = alive.astype(np.float64) + 1e-6
+    sums = np.zeros((n_groups, obs.shape[1]))
+    np.add.at(sums, group, obs * w[:, None])
+    tot = np.zeros(n_groups)
+    np.add.at(tot, group, w)
+    return (sums / tot[:, None])[group].astype(np.float32)
+
+
+def greedy_joint(logits: np.ndarray, dims: tuple[int, ...]) -> np.ndarray:
+    """Joint action of per-head argmax (ties to the lower index) of (N, sum(dims)) logits."""
+    out = np.zeros(logits.shape[0], dtype=np.int64)
+    start = 0
+    for d in dims:
+        out = out * d + np.argmax(logits[:, start:start + d], axis=1)
+        start += d
+    return out
+
+
+@dataclass
+class Rollout:
+    """S steps of N agents: obs (S, N, F), critic inputs (S, N, C), heads (S, N, H) ints, logp / value /
+    reward (S, N), done / active (S, N) bools, and the value of the observation after the last step (N,)."""
+
+    obs: np.ndarray
+    critic: np.ndarray
+    heads: np.ndarray
+    logp: np.ndarray
+    value: np.ndarray
+    reward: np.ndarray
+    done: np.ndarray
+    active: np.ndarray
+    last_value: np.ndarray
+
+
+def gae(reward: np.ndarray, value: np.ndarray, done: np.ndarray, active: np.ndarray, last_value: np.ndarray,
+        gamma: float, lam: float) -> tuple[np.ndarray, np.ndarray]:
+    """(advantages, returns) (S, N): A_t = delta_t + gamma lambda (1 - done_t) A_{t+1}, delta_t = r_t + gamma
+    (1 - done_t) V_{t+1} - V_t; inactive steps are zero and cut the stream."""
+    s = reward.shape[0]
+    adv = np.zeros_like(reward)
+    nxt_v, nxt_a = last_value, np.zeros_like(last_value)
+    for t in range(s - 1, -1, -1):
+        keep = (~done[t]).astype(np.float64)
+        delta = reward[t] + gamma * keep * nxt_v - value[t]
+        adv[t] = np.where(active[t], delta + gamma * lam * keep * nxt_a, 0.0)
+        nxt_v = np.where(active[t], value[t], 0.0)
+        nxt_a = adv[t]
+    return adv, adv + value
+
+
+class PPO:
+    """The learner: :meth:`act` during rollouts, :meth:`update` after each, data-only :meth:`state_dict`."""
+
+    kind = "ppo"
+
+    def __init__(self, n_features: int, dims: tuple[int, ...], config: PPOConfig | None = None, seed: int = 0) -> None:
+        self.config = config or PPOConfig()
+        if self.config.threads:
+            torch.set_num_threads(self.config.threads)
+        torch.manual_seed(seed)
+        self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic)
+        self.opt = torch.optim.Adam(self.net.parameters(), lr=self.config.lr, eps=1e-5)
+        self.gen = torch.Generator().manual_seed(seed)
+        self.dims = self.net.dims
+        self.n_features = n_features
+        self.updates = 0
+
+    @property
+    def n_actions(self) -> int:
+        """Joint actions."""
+        return int(np.prod(self.dims))
+
+    def critic_input(self, obs: np.ndarray, group: np.ndarray, n_groups: int, alive: np.ndarray) -> np.ndarray:
+        """What the critic sees: the own view, and with ``team_critic`` the team's mean view beside it."""
+        if not self.config.team_critic:
+            return obs
+        return np.concatenate([obs, team_mean(obs, group, n_groups, alive)], axis=1)
+
+    @torch.no_grad()
+    def act(self, obs: np.ndarray, critic_in: np.ndarray | None = None, explore: bool = True
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(joint actions (N,), heads (N, H), log-probabilities (N,), values (N,)) for (N, F) observations;
+        greedy (per-head argmax) without ``explore``; values are 0 without ``critic_in``."""
+        o = torch.from_numpy(np.ascontiguousarray(obs, dtype=np.float32))
+        logps = self.net.heads(o)
+        if explore:
+            heads = [torch.multinomial(lp.exp(), 1, generator=self.gen).squeeze(1) for lp in logps]
+        else:
+            heads = [lp.argmax(dim=1) for lp in logps]
+        logp = sum(lp.gather(1, h[:, None]).squeeze(1) for lp, h in zip(logps, heads, strict=True))
+        h = torch.stack(heads, dim=1).numpy()
+        value = (self.net.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+                 if critic_in is not None else np.zeros(len(obs), np.float32))
+        return np.ravel_multi_index(tuple(h.T), self.dims), h, logp.numpy(), value  # type: ignore[union-attr]
+
+    @torch.no_grad()
+    def values(self, critic_in: np.ndarray) -> np.ndarray:
+        """V of (N, C) critic inputs."""
+        return self.net.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+
+    def update(self, ro: Rollout) -> dict[str, float]:
+        """One PPO update on a rollout; returns the losses, entropy, KL and clip fraction (means)."""
+        c = self.config
+        adv, ret = gae(ro.reward, ro.value.astype(np.float64), ro.done, ro.active, ro.last_value.astype(np.float64),
+                       c.gamma, c.gae_lambda)
+        m = ro.active.reshape(-1)
+        obs = torch.from_numpy(ro.obs.reshape(-1, ro.obs.shape[-1])[m])
+        crit = torch.from_numpy(ro.critic.reshape(-1, ro.critic.shape[-1])[m])
+        heads = torch.from_numpy(ro.heads.reshape(-1, ro.heads.shape[-1])[m])
+        old_logp = torch.from_numpy(ro.logp.reshape(-1)[m].astype(np.float32))
+        old_v = torch.from_numpy(ro.value.reshape(-1)[m].astype(np.float32))
+        adv_t = torch.from_numpy(adv.reshape(-1)[m].astype(np.float32))
+        ret_t = torch.from_numpy(ret.reshape(-1)[m].astype(np.float32))
+        n = obs.shape[0]
+        stats = {"policy_loss": 0.0, "value_loss": 0.0, "entropy": 0.0, "approx_kl": 0.0, "clip_frac": 0.0}
+        if n == 0:
+            return stats
+        size = max(1, n // c.minibatches)
+        count = 0
+        for _ in range(c.epochs):
+            perm = torch.randperm(n, generator=self.gen)
+            for start in range(0, n, size):
+                idx = perm[start:start + size]
+                logps = self.net.heads(obs[idx])
+                h = heads[idx]
+                logp = sum(lp.gather(1, h[:, k:k + 1]).squeeze(1) for k, lp in enumerate(logps))
+                entropy = sum(-(lp.exp() * lp).sum(dim=1) for lp in logps).mean()
+                ratio = (logp - old_logp[idx]).exp()
+                a = adv_t[idx]
+                a = (a - a.mean()) / (a.std() + 1e-8) if len(idx) > 1 else a
+                pg = torch.max(-a * ratio, -a * ratio.clamp(1 - c.clip, 1 + c.clip)).mean()
+                v = self.net.value(crit[idx])
+                v_clip = old_v[idx] + (v - old_v[idx]).clamp(-c.clip, c.clip)
+                vl = 0.5 * torch.max((v - ret_t[idx]) ** 2, (v_clip - ret_t[idx]) ** 2).mean()
+                loss = pg - c.ent_coef * entropy + c.vf_coef * vl
+                self.opt.zero_grad()
+                loss.backward()
+                nn.utils.clip_grad_norm_(self.net.parameters(), c.max_grad_norm)
+                self.opt.step()
+                with torch.no_grad():
+                    lr = logp - old_logp[idx]
+                    stats["approx_kl"] += float(((lr.exp() - 1) - lr).mean())
+                    stats["clip_frac"] += float(((ratio - 1).abs() > c.clip).float().mean())
+                stats["policy_loss"] += float(pg.detach())
+                stats["value_loss"] += float(vl.detach())
+                stats["entropy"] += float(entropy.detach())
+                count += 1
+        self.updates += 1
+        out = {k: v / count for k, v in stats.items()}
+        out["explained_variance"] = float(1 - np.var(ret.reshape(-1)[m] - ro.value.reshape(-1)[m])
+                                          / (np.var(ret.reshape(-1)[m]) + 1e-12))
+        return out
+
+    # -- data-only state ---------------------------------------------------------------------------------
+    def actor_arrays(self) -> dict[str, np.ndarray]:
+        """The actor's layers as w0, b0, w1, b1, w2, b2 (weights (out, in), float64): what export needs."""
+        layers = [m for m in self.net.actor if isinstance(m, nn.Linear)]
+        out: dict[str, np.ndarray] = {}
+        for i, layer in enumerate(layers):
+            out[f"w{i}"] = layer.weight.detach().numpy().astype(np.float64)
+            out[f"b{i}"] = layer.bias.detach().numpy().astype(np.float64)
+        return out
+
+    def load_actor_arrays(self, d: dict[str, np.ndarray]) -> None:
+        """Set the actor from :meth:`actor_arrays`' output."""
+        layers = [m for m in self.net.actor if isinstance(m, nn.Linear)]
+        with torch.no_grad():
+            for i, layer in enumerate(layers):
+                w, b = np.asarray(d[f"w{i}"]), np.asarray(d[f"b{i}"])
+                if w.shape != tuple(layer.weight.shape) or b.shape != tuple(layer.bias.shape):
+                    raise ValueError(f"actor layer {i}: got {w.shape}/{b.shape}, expected "
+                                     f"{tuple(layer.weight.shape)}/{tuple(layer.bias.shape)}")
+                layer.weight.copy_(torch.from_numpy(w.astype(np.float32)))
+                layer.bias.copy_(torch.from_numpy(b.astype(np.float32)))
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """Network, Adam moments, sampling generator and update count as arrays."""
+        d = {f"net.{k}": v.detach().numpy().copy() for k, v in self.net.state_dict().items()}
+        opt = self.opt.state_dict()
+        for pid, st in opt["state"].items():
+            for k, v in st.items():
+                d[f"opt.{pid}.{k}"] = v.detach().numpy().copy() if torch.is_tensor(v) else np.asarray(v)
+        d["gen"] = self.gen.get_state().numpy().copy()
+        d["updates"] = np.asarray(self.updates)
+        return d
+
+    def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
+        """Restore :meth:`state_dict`'s output (ValueError on a mismatch)."""
+        try:
+            self.net.load_state_dict({k[4:]: torch.from_numpy(np.array(v)) for k, v in d.items()
+                                      if k.startswith("net.")})
+        except RuntimeError as exc:
+            raise ValueError(f"network does not fit: {str(exc).splitlines()[0]}") from None
+        opt = self.opt.state_dict()
+        state: dict[int, dict[str, torch.Tensor]] = {}
+        for k, v in d.items():
+            if k.startswith("opt."):
+                _, pid, name = k.split(".", 2)
+                state.setdefault(int(pid), {})[name] = torch.from_numpy(np.array(v))
+        opt["state"] = state
+        self.opt.load_state_dict(opt)
+        self.gen.set_state(torch.from_numpy(np.asarray(d["gen"], dtype=np.uint8)))
+        self.updates = int(d["updates"])

@@ -193,19 +193,20 @@ def _left_prob(q0: float, q1: float, code: int, temp: float, thr: float) -> tupl
 def _run_chunk(q: np.ndarray, u: np.ndarray, e0: int, code: int, expected: bool, alpha: float, gamma: float,
                t_max: float, t_min: float, eta: float, exploit: float, decay: float, goal: int, reward: float,
                rows: np.ndarray, cols: np.ndarray, limits: np.ndarray, tol: float, first: np.ndarray,
-               last_bad: np.ndarray, ok: np.ndarray, bands: np.ndarray, runs: np.ndarray, keep: bool) -> None:
-    """Episodes e0 .. e0 + u.shape[1] - 1 of every seed of one method; ``q`` ``(S, 2^(N-1), 2)`` and the
-    trackers are updated in place."""
+               last_bad: np.ndarray, ok: np.ndarray, bands: np.ndarray, order: np.ndarray, runs: np.ndarray,
+               keep: bool) -> None:
+    """Episodes e0 .. e0 + u.shape[1] - 1 of every seed of one method; ``q`` ``(S, 2^(N-1), 2)``, the
+    trackers and ``order`` (per tracked Q, the seeds ranked by value) are updated in place."""
     seeds, n, moves = u.shape
     path = np.empty(moves + 1, np.int64)
     acts = np.empty(moves, np.int64)
     target = np.empty(moves)
-    vals = np.empty((seeds, rows.size))
-    for k in range(n):
-        e = e0 + k
-        temp = t_min + (t_max - t_min) * eta**e  # Eq. 7 iterated from T_0 = T_max, once per episode
-        thr = 1.0 - (1.0 - exploit) * decay**e if code == 2 else exploit  # Dgreedy: (1 - eps_e) = (1 - eps_0) d^e
-        for s in range(seeds):
+    vals = np.empty((n, rows.size, seeds))
+    for s in range(seeds):  # one seed's episodes in a row: its table stays in cache
+        for k in range(n):
+            e = e0 + k
+            temp = t_min + (t_max - t_min) * eta**e  # Eq. 7 iterated from T_0 = T_max, once per episode
+            thr = 1.0 - (1.0 - exploit) * decay**e if code == 2 else exploit  # Dgreedy: 1 - eps_e = (1 - eps_0) d^e
             path[0] = 1
             for i in range(moves):
                 p0, _ = _left_prob(q[s, path[i], 0], q[s, path[i], 1], code, temp, thr)
@@ -230,19 +231,27 @@ def _run_chunk(q: np.ndarray, u: np.ndarray, e0: int, code: int, expected: bool,
                 first[s] = e + 1
             for j in range(rows.size):
                 x = q[s, rows[j], cols[j]]
-                vals[s, j] = x
+                vals[k, j, s] = x
                 ok[s, j] = abs(x - limits[j]) <= tol * abs(limits[j])
                 if not ok[s, j]:
                     last_bad[s, j] = e
                 if keep:
                     runs[s, e, j] = x
-        for j in range(rows.size):  # quartiles over seeds, linear interpolation as np.quantile
-            srt = np.sort(vals[:, j])
+    for k in range(n):  # quartiles over seeds per episode, linear interpolation as np.quantile
+        for j in range(rows.size):
+            o, x = order[j], vals[k, j]  # last episode's ranking: values move little, so insertion sort is ~linear
+            for i in range(1, seeds):
+                key = o[i]
+                p = i - 1
+                while p >= 0 and x[o[p]] > x[key]:
+                    o[p + 1] = o[p]
+                    p -= 1
+                o[p + 1] = key
             for t, level in enumerate((0.25, 0.5, 0.75)):
                 pos = level * (seeds - 1)
                 lo = int(np.floor(pos))
                 hi = min(lo + 1, seeds - 1)
-                bands[t, e, j] = srt[lo] + (srt[hi] - srt[lo]) * (pos - lo)
+                bands[t, e0 + k, j] = x[o[lo]] + (x[o[hi]] - x[o[lo]]) * (pos - lo)
 
 
 def run_migration(
@@ -282,13 +291,14 @@ def run_migration(
     ok = {m: np.zeros((seeds, len(TRACKED)), bool) for m in methods}
     first = {m: np.full(seeds, np.nan) for m in methods}
     bands = {m: np.empty((3, episodes, len(TRACKED))) for m in methods}
+    order = {m: np.tile(np.arange(seeds), (len(TRACKED), 1)) for m in methods}
     runs = {m: np.empty((seeds, episodes, len(TRACKED)) if keep_runs else (1, 1, 1)) for m in methods}
     e0 = 0
     for u in seed_draws(seed, seeds, episodes, moves):
         for m, p in learners.items():
             _run_chunk(tables[m], u, e0, EXPLORE_CODES[p.exploration], p.bootstrap == "expected", p.alpha,
                        p.gamma, p.t_max, p.t_min, p.eta, p.exploit, p.exploit_decay, goal, 1000.0, rows, cols,
-                       limits, tol, first[m], last_bad[m], ok[m], bands[m], runs[m], keep_runs)
+                       limits, tol, first[m], last_bad[m], ok[m], bands[m], order[m], runs[m], keep_runs)
         e0 += u.shape[1]
     conv = {m: np.where(ok[m], last_bad[m] + 2.0, np.nan) for m in methods}  # 1-based episode after the last miss
     final = {m: tables[m][:, rows, cols].copy() for m in methods}

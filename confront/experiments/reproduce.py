@@ -195,7 +195,7 @@ def compare(text: str, figure: str, a: np.ndarray, b: np.ndarray, name_a: str, n
     sign = 1.0 if alternative == "greater" else -1.0
     right = res.p < ALPHA
     short = paper_diff is not None and sign * (d.hi if sign > 0 else d.lo) < sign * paper_diff
-    verdict = ("partly" if short else "holds") if right else "no"
+    verdict = ("partly" if short else "holds") if right else "no" if res.n > 1 else "n/a"  # n/a: one seed, no test
     crit = f"holds if a paired permutation test finds {name_a} {'>' if sign > 0 else '<'} {name_b} at p < {ALPHA}"
     if paper_diff is not None:
         crit += f" and the 95% CI reaches the paper's difference ({paper_diff:+.2g}); partly if only the direction"

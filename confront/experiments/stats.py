@@ -93,11 +93,14 @@ def permutation_test(a: np.ndarray, b: np.ndarray, rng: np.random.Generator, n_p
 def paired_permutation_test(a: np.ndarray, b: np.ndarray, rng: np.random.Generator, n_perm: int = 20000,
                             alternative: str = "greater") -> float:
     """Paired (seed i of ``a`` with seed i of ``b``): p-value of mean(a - b) when each pair's sign may flip
-    (SciPy's ``permutation_test`` with ``permutation_type="samples"``, exact up to 2^n <= ``n_perm``)."""
+    (SciPy's ``permutation_test`` with ``permutation_type="samples"``, exact up to 2^n <= ``n_perm``); NaN for
+    fewer than 2 pairs."""
     _check_alternative(alternative)
     a, b = np.asarray(a, float), np.asarray(b, float)
     if a.shape != b.shape:
         raise ValueError(f"paired samples need one value per seed in both, got {a.shape} and {b.shape}")
+    if a.size < 2:
+        return float("nan")
     res = stats.permutation_test((a, b), _mean_diff, vectorized=True, permutation_type="samples",
                                  n_resamples=n_perm, alternative=alternative, random_state=rng)
     return float(res.pvalue)

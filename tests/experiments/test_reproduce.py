@@ -143,6 +143,7 @@ def test_paired_compare_gives_three_verdicts() -> None:
     assert compare("x", "-", b + 0.15 + noise, b, "A", "B", rng, paper_diff=0.1).verdict == "holds"
     worse = compare("x", "-", b - 0.05 + noise, b, "A", "B", rng)
     assert worse.verdict == "no" and float(worse.p) == pytest.approx(1.0)
+    assert compare("x", "-", b[:1] + 0.2, b[:1], "A", "B", rng).verdict == "n/a"  # one seed: nothing to test
     assert Claim("t", "-", "o", None).verdict == "n/a" and Claim("t", "-", "o", verdict="partly").holds is False
     with pytest.raises(ValueError, match="verdict"):
         Claim("t", "-", "o", verdict="maybe")

@@ -61,6 +61,7 @@ def test_exact_paired_permutation_p_value() -> None:
     # (1, -2, 3), sum 2: the flips with a sum >= 2 are (1, -2, 3), (1, 2, 3) and (-1, 2, 3) -> p = 3/8
     p = paired_permutation_test(np.array([2.0, -1.0, 4.0]), np.array([1.0, 1.0, 1.0]), np.random.default_rng(0))
     assert p == pytest.approx(3 / 8)
+    assert np.isnan(paired_permutation_test(np.ones(1), np.zeros(1), np.random.default_rng(0)))  # one pair: no test
     with pytest.raises(ValueError, match="one value per seed"):
         paired_permutation_test(np.ones(3), np.ones(2), np.random.default_rng(0))
 

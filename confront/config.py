@@ -76,6 +76,8 @@ def _check_bounds(key: str, value: Any, meta: Mapping[str, Any]) -> None:
         )
         if bad:
             raise ConfigError(f"{key} = {value!r} is out of range: must be {_allowed(meta)}")
+        if isinstance(value, int) and not -(2**63) <= value < 2**63:
+            raise ConfigError(f"{key} = {value!r} is out of range: must fit in 64 bits")
 
 
 def _type_name(tp: Any) -> str:
@@ -126,16 +128,12 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"{key} = {value!r} has the wrong type: expected a number")
-        if isinstance(value, int) and abs(value) > 2**53:
-            raise ConfigError(f"{key} = {value!r} is out of range: must be a number of at most 2^53 in size")
-        if not math.isfinite(value):
-            raise ConfigError(f"{key} = {value!r} is out of range: must be a finite number")
+        if isinstance(value, int) and abs(value) > 2**1000 or not math.isfinite(value):
+            raise ConfigError(f"{key} = {str(value)[:60]} is out of range: must be a finite number")
         return float(value)
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise ConfigError(f"{key} = {value!r} has the wrong type: expected an integer")
-        if not -(2**63) <= value < 2**63:
-            raise ConfigError(f"{key} = {value!r} is out of range: must fit in 64 bits")
         return value
     if tp is bool:
         if not isinstance(value, bool):
@@ -170,8 +168,9 @@ def from_dict(cls: type[T], data: Mapping[str, Any], prefix: str = "") -> T:
     except ConfigError:
         raise
     except (ValueError, TypeError) as exc:  # a class's own __post_init__ check
-        where = f" in {prefix}" if prefix else ""
-        raise ConfigError(f"{str(exc).splitlines()[0]}{where}") from None
+        msg = str(exc).splitlines()[0]
+        where = f" in {prefix}" if prefix and f"{prefix}." not in msg else ""
+        raise ConfigError(f"{msg}{where}") from None
 
 
 def to_dict(obj: Any) -> dict[str, Any]:

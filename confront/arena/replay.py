@@ -271,10 +271,11 @@ def load_replay(path: str | Path) -> Replay:
             raise ReplayError(f"it holds more than {MAX_BYTES >> 20} MB of JSON")
         return Replay.from_dict(json.loads(raw))
     except ReplayError as exc:
-        raise ReplayError(f"replay {str(p)!r}: {exc}") from None
+        raise ReplayError(f"replay {str(p)!r}: {str(exc).removeprefix('replay ')}") from None
     except (OSError, EOFError, ValueError, RecursionError, zlib.error) as exc:  # gzip, JSON, Unicode errors
         why = str(exc).splitlines()[0][:200] if str(exc).strip() else type(exc).__name__
-        raise ReplayError(f"replay {str(p)!r} cannot be read: {why}") from None
+        raise ReplayError(f"replay {str(p)!r} cannot be read ({why}): give a confront replay .json or .json.gz file"
+                          ) from None
 
 
 def _frame_indices(n: int, max_frames: int | None, every: int) -> list[int]:

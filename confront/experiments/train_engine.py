@@ -32,11 +32,13 @@ from confront import checkpoint as ck
 from confront.arena.observe import ObservationConfig
 from confront.arena.state import SCORE_PARTS
 from confront.checkpoint import CheckpointError
+from confront.config import ConfigError
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
 from confront.engine.bridge import Action, Observation, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
 from confront.engine.evaluate import _single_star
 from confront.engine.export import ExportedPolicy, export_robot
+from confront.engine.install import find_engine
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
 from confront.experiments.spec import ExperimentConfig
@@ -125,16 +127,16 @@ def _opponent(cfg: ExperimentConfig, obs_cfg: ObservationConfig, robots: Path,
 
 def _check(cfg: ExperimentConfig) -> None:
     if cfg.arena.scenario not in SCENARIO_SIZES:
-        raise ValueError(f"arena.scenario = {cfg.arena.scenario!r}: the engine plays {sorted(SCENARIO_SIZES)}")
+        raise ConfigError(f"arena.scenario = {cfg.arena.scenario!r}: the engine plays {sorted(SCENARIO_SIZES)}")
     if cfg.arena.sensing != "scanned":
-        raise ValueError("arena.sensing = 'true' is not possible in the engine (robots know what they scanned)")
+        raise ConfigError("arena.sensing = 'true' is not possible in the engine (robots know what they scanned)")
     if cfg.arena.fire_power_actions:
-        raise ValueError("arena.fire_power_actions = true is not supported in the engine (4 moves only)")
+        raise ConfigError("arena.fire_power_actions = true is not supported in the engine (4 moves only)")
     if cfg.opponent.kind != "td":
         try:
             robot_class(cfg.opponent.kind)
         except ValueError as exc:
-            raise ValueError(f"opponent.kind: {exc}") from None
+            raise ConfigError(f"opponent.kind: {exc}") from None
 
 
 def _transfer(cfg: ExperimentConfig, learner: Learner) -> tuple[Learner, dict[str, Any]]:
@@ -218,6 +220,7 @@ def train_in_engine(
     elif cfg is None:
         raise ValueError("train_in_engine needs a config unless resuming")
     _check(cfg)
+    find_engine()  # no engine: a one-line error before any run folder is made
     obs_cfg = ObservationConfig(target=cfg.arena.target)
     learner = build_learner(cfg, obs_cfg.n_features, N_MOVES)
     acting, transfer_info = _transfer(cfg, learner)
@@ -239,7 +242,12 @@ def train_in_engine(
                unit="round", disable=not progress, dynamic_ncols=True)
     try:
         with tempfile.TemporaryDirectory(prefix="confront-train-") as tmp:
-            opponent, extra, info = _opponent(cfg, obs_cfg, Path(tmp) / "robots", progress)
+            try:
+                opponent, extra, info = _opponent(cfg, obs_cfg, Path(tmp) / "robots", progress)
+            except Exception:
+                if not resume:
+                    run.discard_if_new()  # a failed start leaves no half-made run folder
+                raise
             while state["rounds_done"] < total:
                 rounds = min(chunk, total - state["rounds_done"])
                 # a training battle gets time: 10 s per round on top of the default limit

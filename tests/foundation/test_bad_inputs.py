@@ -1,0 +1,198 @@
+"""A corpus of user mistakes run through the command line: each exits 2 with one line on stderr that names the
+input, prints no traceback, and leaves every file that was there before byte-identical (and makes no run folder).
+"""
+
+from __future__ import annotations
+
+import gzip
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from confront.cli.main import cli
+
+TINY = ("--set", "train.rounds=4", "--set", "train.session_rounds=2", "--set", "train.checkpoint_every=2",
+        "--set", "opponent.kind=SpinBot", "--set", "arena.battles=2")
+
+
+@pytest.fixture(scope="module")
+def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A workspace: a small trained run, a resumable copy, broken copies, and bad files of every kind."""
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import train_run
+
+    root = tmp_path_factory.mktemp("ws")
+    cfg = load_experiment("demo", [t for t in TINY if t != "--set"])
+    train_run(cfg, root / "run", progress=False)
+    shutil.copytree(root / "run", root / "resumable")
+    (root / "resumable" / "summary.json").unlink()
+    edited = root / "edited"
+    shutil.copytree(root / "resumable", edited)
+    meta = edited / "checkpoints" / "round-000002" / "meta.json"
+    meta.write_text(meta.read_text().replace('"rounds_done": 2', '"rounds_done": 1300'))
+    pointer = root / "pointer"
+    shutil.copytree(root / "resumable", pointer)
+    (pointer / "checkpoints" / "LATEST").write_text("../../run\n")
+    shutil.copytree(root / "run", root / "listmodel")
+    (root / "listmodel" / "model" / "model.json").write_text("[]")
+    shutil.copytree(root / "run", root / "truncated")
+    npz = root / "truncated" / "model" / "learner.npz"
+    npz.write_bytes(npz.read_bytes()[:100])
+    (root / "afile").write_text("not a folder\n")
+    (root / "adir").mkdir()
+    (root / "latin1.toml").write_bytes('name = "d\xe9mo"\n'.encode("latin-1"))
+    (root / "wide.toml").write_text('name = "wide"\nteams = [2, 2]\nwidth = 20000\nheight = 600\n')
+    (root / "notgzip.replay.json.gz").write_bytes(b"plain text, not gzip")
+    good = json.loads(gzip.decompress((root / "run" / "replays" / "last_round.replay.json.gz").read_bytes()))
+    (root / "nokeys.replay.json").write_text(json.dumps({"format": "confront-replay/1", "width": 800}))
+    (root / "wide.replay.json").write_text(json.dumps({**good, "width": 20000}))
+    (root / "frames.replay.json").write_text(json.dumps({**good, "n_frames": 10**9}))
+    (root / "robots.replay.json").write_text(json.dumps({**good, "names": ["r"] * 5000, "teams": [0] * 5000}))
+    (root / "bomb.replay.json.gz").write_bytes(gzip.compress(b" " * (65 << 20)))
+    (root / "grid.toml").write_text('experiment = "demo"\nseeds = 1\n')
+    return root
+
+
+# (arguments with {ws} for the workspace, text the error line must contain, path that must not appear)
+CASES: list[tuple[str, list[str], str, str | None]] = [
+    ("unknown scenario", ["train", "--set", "arena.scenario=nope", "--out", "{ws}/new"], "arena.scenario", "new"),
+    ("scenario file outside Robocode", ["train", "--set", "arena.scenario={ws}/wide.toml", "--out", "{ws}/new"],
+     "arena.scenario", "new"),
+    ("infinite temperature", ["train", "--set", "learner.t_max=inf", "--out", "{ws}/new"], "learner.t_max", "new"),
+    ("nan rate", ["train", "--set", "learner.alpha=nan", "--out", "{ws}/new"], "learner.alpha", "new"),
+    ("empty hidden layer", ["train", "--set", "learner.hidden=[0]", "--out", "{ws}/new"], "learner.hidden[0]",
+     "new"),
+    ("seed 2^70 in the config", ["train", "--set", f"train.seed={2**70}", "--out", "{ws}/new"], "train.seed", "new"),
+    ("seed 2^70 option", ["train", "--seed", str(2**70), "--out", "{ws}/new"], "--seed", "new"),
+    ("negative seed", ["battle", "--seed", "-1"], "--seed", None),
+    ("run name with a newline", ["train", "--set", 'name="a\\nb"', "--out", "{ws}/new"], "name", "new"),
+    ("run name with a path", ["train", "--set", "name=../../evil"], "name", None),
+    ("unknown opponent", ["train", "--set", "opponent.kind=Nobody", "--out", "{ws}/new"], "opponent.kind", "new"),
+    ("config is a folder", ["train", "-c", "{ws}/adir", "--out", "{ws}/new"], "is a folder", "new"),
+    ("config is not UTF-8", ["train", "-c", "{ws}/latin1.toml", "--out", "{ws}/new"], "UTF-8", "new"),
+    ("unknown experiment", ["train", "-c", "nosuch", "--out", "{ws}/new"], "unknown experiment 'nosuch'", "new"),
+    ("missing transfer source", ["train", *TINY, "--set", "transfer.source={ws}/nosuch", "--out", "{ws}/new"],
+     "no trained model", "new"),
+    ("missing TD model", ["train", *TINY[:-4], "--set", "opponent.model={ws}/nosuch", "--out", "{ws}/new"],
+     "no trained model", "new"),
+    ("out is a file", ["train", "--out", "{ws}/afile"], "afile", None),
+    ("out is an existing run", ["train", "--out", "{ws}/run"], "already exists", None),
+    ("resume with --set", ["train", "--resume", "{ws}/resumable", "--set", "train.rounds=9"], "--set", None),
+    ("resume with -c", ["train", "--resume", "{ws}/resumable", "-c", "awm"], "-c", None),
+    ("resume with --out", ["train", "--resume", "{ws}/resumable", "--out", "{ws}/new"], "--out", "new"),
+    ("resume with --seed 0", ["train", "--resume", "{ws}/resumable", "--seed", "0"], "--seed", None),
+    ("resume an edited checkpoint", ["train", "--resume", "{ws}/edited", "--quiet"], "edited or corrupt", None),
+    ("resume a bad LATEST", ["train", "--resume", "{ws}/pointer", "--quiet"], "LATEST", None),
+    ("resume a folder that is no run", ["train", "--resume", "{ws}/adir"], "not a run folder", None),
+    ("engine training with true sensing", ["train", "--engine", "robocode", "--set", "arena.sensing=true", "--out",
+                                           "{ws}/new"], "arena.sensing", "new"),
+    ("battle of 0 rounds", ["battle", "--rounds", "0"], "--rounds", None),
+    ("battle of 0 battles", ["battle", "--battles", "0"], "--battles", None),
+    ("unknown robot", ["battle", "--robots", "SpinBot,Nobody"], "Nobody", None),
+    ("evaluate 0 rounds", ["evaluate", "{ws}/run", "--rounds", "0"], "--rounds", None),
+    ("evaluate a model.json of []", ["evaluate", "{ws}/listmodel", "--rounds", "2"], "not a confront model", None),
+    ("evaluate a truncated learner.npz", ["evaluate", "{ws}/truncated", "--rounds", "2"], "cannot be read", None),
+    ("evaluate a missing run", ["evaluate", "{ws}/nosuch"], "nosuch", None),
+    ("export onto a file", ["export", "{ws}/run", "--out", "{ws}/afile"], "afile", None),
+    ("export --name", ["export", "{ws}/run", "--out", "{ws}/robots", "--name", "X"], "--name", "robots"),
+    ("replay of a non-gzip .gz", ["replay", "{ws}/notgzip.replay.json.gz"], "notgzip", None),
+    ("replay with missing keys", ["replay", "{ws}/nokeys.replay.json"], "lacks the keys", None),
+    ("replay 20000 wide", ["replay", "{ws}/wide.replay.json"], "outside Robocode", None),
+    ("replay of 10^9 frames", ["replay", "{ws}/frames.replay.json"], "n_frames", None),
+    ("replay of 5000 robots", ["replay", "{ws}/robots.replay.json"], "robots", None),
+    ("replay gzip bomb", ["replay", "{ws}/bomb.replay.json.gz"], "64 MB", None),
+    ("sweep without Ray", ["sweep", "{ws}/grid.toml", "--out", "{ws}/sweep"], "'ray'", "sweep"),
+    ("demo of 0 rounds", ["demo", "--rounds", "0"], "--rounds", None),
+    ("config show with a bad override", ["config", "show", "demo", "--set", "learner.hidden=[-3]"],
+     "learner.hidden[0]", None),
+]
+
+
+def _snapshot(root: Path) -> dict[str, str]:
+    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else "dir"
+            for p in sorted(root.rglob("*"))}
+
+
+@pytest.mark.parametrize(("name", "args", "expect", "absent"), CASES, ids=[c[0] for c in CASES])
+def test_user_mistake_is_one_line_exit_2(ws: Path, name: str, args: list[str], expect: str, absent: str | None,
+                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CONFRONT_CACHE", str(ws / "cache"))
+    monkeypatch.chdir(ws)
+    monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` fails as without the extra
+    before = _snapshot(ws)
+    result = CliRunner().invoke(cli, [a.replace("{ws}", str(ws)) for a in args])
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2, (result.output, result.exception)
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert expect in lines[0]
+    assert "Traceback" not in result.output
+    after = _snapshot(ws)
+    assert {k: v for k, v in after.items() if not k.startswith("cache")} == {
+        k: v for k, v in before.items() if not k.startswith("cache")}
+    if absent is not None:
+        assert not (ws / absent).exists()
+
+
+@pytest.mark.parametrize("args", [["train", "--set", "arena.scenario=nope"], ["replay", "{ws}/notgzip.replay.json.gz"],
+                                  ["export", "{ws}/run", "--out", "{ws}/afile"], ["battle", "--rounds", "0"]])
+def test_no_traceback_in_a_real_process(ws: Path, args: list[str]) -> None:
+    proc = subprocess.run([sys.executable, "-m", "confront.cli.main", *[a.replace("{ws}", str(ws)) for a in args]],
+                          capture_output=True, text=True, cwd=ws, timeout=300)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and proc.stderr.startswith("error: ")
+
+
+def test_missing_engine_is_one_line_and_no_run_folder(ws: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CONFRONT_ROBOCODE_JAR", str(ws / "nosuch.jar"))
+    result = CliRunner().invoke(cli, ["train", "--engine", "robocode", "--out", str(ws / "new"), "--quiet"])
+    assert result.exit_code == 2 and result.stderr.startswith("error: Robocode engine not found")
+    assert len(result.stderr.strip().splitlines()) == 1 and not (ws / "new").exists()
+
+
+def test_corrupt_td_cache_is_rebuilt_aloud(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import td_team
+
+    monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path))
+    cfg = load_experiment("demo", ["opponent.pretrain_rounds=2"])
+    first, where = td_team(cfg, 4)
+    npz = where / "learner.npz"
+    good = npz.read_bytes()
+    npz.write_bytes(good[: len(good) // 2])  # a truncated zip: BadZipFile
+    said: list[str] = []
+    monkeypatch.setattr("click.echo", lambda text, err=False: said.append(text))
+    again, where2 = td_team(cfg, 4)
+    assert where2 == where and len(said) == 1 and "cached TD team cannot be used" in said[0]
+    assert again.state_dict().keys() == first.state_dict().keys()
+    td_team(cfg, 4)  # the rebuilt entry loads without a word
+    assert len(said) == 1
+
+
+def test_missing_latest_resumes_from_the_newest_checkpoint_aloud(ws: Path, tmp_path: Path,
+                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CONFRONT_CACHE", str(ws / "cache"))
+    run = tmp_path / "run"
+    shutil.copytree(ws / "resumable", run)
+    (run / "checkpoints" / "LATEST").unlink()
+    result = CliRunner().invoke(cli, ["train", "--resume", str(run), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert "LATEST is missing; using round-000002" in result.stderr
+    assert (run / "metrics" / "rounds.csv").read_text() == (ws / "run" / "metrics" / "rounds.csv").read_text()
+
+
+def test_demo_rounds_below_its_session_are_allowed(monkeypatch: pytest.MonkeyPatch) -> None:
+    import confront.experiments.train as train
+
+    got = []
+    monkeypatch.setattr(train, "train_run", lambda cfg, out, progress: got.append(cfg) or {})
+    monkeypatch.setattr(train, "print_summary", lambda summary: None)
+    result = CliRunner().invoke(cli, ["demo", "--rounds", "8", "--out", "unused"])
+    assert result.exit_code == 0, result.output
+    assert (got[0].train.rounds, got[0].train.session_rounds) == (8, 8)
+    assert "sessions of 8 rounds" in result.stderr

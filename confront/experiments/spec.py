@@ -15,8 +15,8 @@ from typing import Literal
 from confront.config import ConfigError, field, from_dict, load_toml, merge, parse_override, to_dict
 
 CONFIG_PACKAGE = "confront.experiments.configs"
-# confront.arena.bots.BOT_NAMES, repeated so that reading a config does not load the simulator (a test keeps
-# the two equal)
+# scripted robots of confront.arena.bots.BOT_NAMES known without loading the simulator (a name outside these is
+# checked against BOT_NAMES itself)
 SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy")
 RUN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 
@@ -66,9 +66,13 @@ class OpponentSection:
     exploit: float = field(0.9, ge=0.0, le=1.0, doc="TD team's epsilon-greedy exploitation threshold (paper's eps)")
 
     def __post_init__(self) -> None:
-        for key, value, allowed in (("kind", self.kind, ("td", *SCRIPTED_BOTS)),
-                                    ("pretrain_against", self.pretrain_against, SCRIPTED_BOTS)):
-            if value not in allowed:
+        for key, value in (("kind", self.kind), ("pretrain_against", self.pretrain_against)):
+            if value in SCRIPTED_BOTS or (key == "kind" and value == "td"):
+                continue
+            from confront.arena.bots import BOT_NAMES
+
+            if value not in BOT_NAMES:
+                allowed = ("td", *BOT_NAMES) if key == "kind" else BOT_NAMES
                 raise ValueError(f"opponent.{key} = {value!r} is not allowed: use one of {', '.join(allowed)}")
 
 

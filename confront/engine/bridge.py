@@ -23,6 +23,11 @@ the robot's commands keep running (remaining distance and turns) with no round t
 instead of JSON keeps the cost low (measured: docs/engine.md). A robot whose Python side fails (no answer
 within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the round and
 reports ``bridge-failed``; the runner collects those reports.
+
+Against other local users: the robots get the token from the engine's environment (``CONFRONT_BRIDGE_TOKEN``,
+readable only by its user), the server reads hellos with a bounded buffer, a deadline and a cap on waiting
+connections, lines of a session up to ``MAX_LINE`` bytes, and checks a robot's end-of-round statistics before
+they are counted (:class:`BridgeServer`, :func:`parse_end`).
 """
 
 from __future__ import annotations

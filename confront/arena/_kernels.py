@@ -48,11 +48,22 @@ from .rules import (
     turn_rate,
     wall_hit_damage,
 )
-from .state import BB_FIELDS, BF_FIELDS, BI_FIELDS, KF_FIELDS, KI_FIELDS, RB_FIELDS, RF_FIELDS, RI_FIELDS
+from .state import (
+    BB_FIELDS,
+    BF_FIELDS,
+    BI_FIELDS,
+    HIT_ROBOT_SLOTS,
+    KF_FIELDS,
+    KI_FIELDS,
+    RB_FIELDS,
+    RF_FIELDS,
+    RI_FIELDS,
+)
 
 # field positions inside the packed groups (compile-time constants for numba)
 X, Y, H, GH, RH, V, E, HEAT, BX, BY, DIST, BODYREM, GUNREM, RADREM, MAXV, MAXTURN, ASSIST, \
-    EVWALLB, EVROBB, EVBULB = range(len(RF_FIELDS))
+    EVWALLB, EVROBB, EVBULB, EVROBN = range(len(RF_FIELDS) - 4 * HIT_ROBOT_SLOTS)
+EVROB0 = EVROBN + 1  # slot k: robot at EVROB0 + 4k, then bearing, at fault, the other's energy
 ALIVE, OVERDRIVE, INCOLL, TRWG, WINNER, ADV, LEADER, DROID, ADJGB, ADJRB, ADJRG, \
     EVWALL, EVFAULT, EVFIRED, EVDIED, SCANREQ = range(len(RB_FIELDS))
 TEAM, EVROBOT, EVHITBY, EVBHIT, EVMISSED = range(len(RI_FIELDS))
@@ -564,6 +575,8 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             rb[b, EVFAULT, i] = True
             ri[b, EVROBOT, j] = i
             rf[b, EVROBB, j] = normal_relative_angle(math.pi + angle - rf[b, H, j])
+            _add_hit_robot(rf, b, i, j, bearing, True, rf[b, E, j])
+            _add_hit_robot(rf, b, j, i, rf[b, EVROBB, j], False, rf[b, E, i])
     # the radar scans this turn if anything moved or turned
     if lh != rf[b, H, i] or lg != rf[b, GH, i] or lr != rf[b, RH, i] or lx != rf[b, X, i] or ly != rf[b, Y, i]:
         last[b, 2, i] = 1.0
@@ -576,6 +589,18 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             rf[b, E, i] = 0.0
             rf[b, DIST, i] = 0.0
             rf[b, BODYREM, i] = 0.0
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _add_hit_robot(rf, b, i, j, bearing, fault, energy):
+    """One HitRobotEvent for robot i per collision, in the order they happen (RobotPeer.checkRobotCollision)."""
+    k = int(rf[b, EVROBN, i])
+    if k < HIT_ROBOT_SLOTS:
+        rf[b, EVROB0 + 4 * k, i] = j
+        rf[b, EVROB0 + 4 * k + 1, i] = bearing
+        rf[b, EVROB0 + 4 * k + 2, i] = 1.0 if fault else 0.0
+        rf[b, EVROB0 + 4 * k + 3, i] = energy
+        rf[b, EVROBN, i] = k + 1
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
@@ -622,8 +647,9 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _clear_events(b, i, rb, ri, scanned):
+def _clear_events(b, i, rb, ri, scanned, rf):
     """Forget robot i's events and scans of the last turn (each turn starts with none)."""
+    rf[b, EVROBN, i] = 0.0
     rb[b, EVWALL, i] = False
     rb[b, EVFAULT, i] = False
     rb[b, EVFIRED, i] = False
@@ -644,7 +670,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     mode = int(params[P_ORDER])
     bi[b, TIME] += 1
     for i in range(n):
-        _clear_events(b, i, rb, ri, scanned)
+        _clear_events(b, i, rb, ri, scanned, rf)
     dead[n] = 0
     # robots are halted 120 turns after the decision (BaseBattle): the commands sent while being halted
     # are the last ones taken, and from then on a robot gains no energy (isExecFinishedAndDisabled)
@@ -790,6 +816,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
             rb[b, EVWALL, i] = False
             rb[b, EVFAULT, i] = False
             rb[b, EVDIED, i] = False
+            rf[b, EVROBN, i] = 0.0
             ri[b, EVROBOT, i] = -1
             ri[b, EVHITBY, i] = 0
             ri[b, EVBHIT, i] = 0
@@ -873,7 +900,7 @@ def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
         rb[b, OVERDRIVE, i] = False
         rb[b, INCOLL, i] = False
         rb[b, TRWG, i] = False
-        _clear_events(b, i, rb, ri, scanned)
+        _clear_events(b, i, rb, ri, scanned, rf)
         for j in range(n):
             scan_time[b, i, j] = -1
             ledger[b, i, j] = 0.0

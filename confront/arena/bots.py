@@ -35,43 +35,97 @@ from . import _kernels as K
 from .core import Arena, _pool
 from .rules import normal_absolute_angle, normal_relative_angle
 from .scenarios import Scenario
+from .state import HIT_ROBOT_SLOTS
 
 __all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind", "bot_battle"]
 
-BOT_NAMES = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy")
-ADVANCED_BOTS = frozenset({"SittingDuck", "SpinBot", "Crazy"})  # the others are plain Robots
-K_NONE, K_DUCK, K_SPIN, K_WALLS, K_TRACKER, K_RAMFIRE, K_FIRE, K_CORNERS, K_CRAZY = range(9)
+BOT_NAMES = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire",
+             "MyFirstLeader", "MyFirstDroid")
+# AdvancedRobots (TeamRobot included); the others are plain Robots
+ADVANCED_BOTS = frozenset({"SittingDuck", "SpinBot", "Crazy", "MyFirstLeader", "MyFirstDroid"})
+K_NONE, K_DUCK, K_SPIN, K_WALLS, K_TRACKER, K_RAMFIRE, K_FIRE, K_CORNERS, K_CRAZY, K_TRACKFIRE, K_LEADER, \
+    K_DROID = range(12)
 
 # operation codes
 O_MOVE, O_TURN, O_GUN, O_RADAR, O_FIRE, O_SCAN, O_STOP, O_RESUME, O_SETMAXV, O_SETMOVE, O_SETTURN, \
-    O_WAITTURN, O_FIREASSIST = range(1, 14)
+    O_WAITTURN, O_FIREASSIST, O_EXECUTE, O_SETRADAR, O_FIRECOOL = range(1, 17)
 Q = 8  # operations per queue
 # memory layout (per robot)
 M_VAR = 0  # 8 bot variables
-M_SAVE = 8  # stop(): saved distance, body, gun, radar remaining
 M_STOPPED = 12  # movement saved by stop() and not yet resumed
 M_PHASE = 13  # run()'s set-up part done
 M_CLOCK = 14  # decisions made this round = time of the turn whose events are being delivered
 M_NEV = 15  # queued events
 M_TOPT, M_TOPSCAN, M_TOPB = 16, 17, 18  # the current top event (time, is a scan, bearing) for fire assist
-# execution levels: 0 = run(), 1..4 = handlers of priority 10, 20, 30, 40 (a handler nests only higher ones)
+M_WON = 19  # the WinEvent of this round was queued
+# execution levels: 0 = run(), then one per handler priority (a handler nests only higher ones): scanned
+# robot 10, hit by bullet 20, hit wall 30, hit robot 40, message 75, win 100
 LV_ACTIVE, LV_LEN, LV_POS, LV_START, LV_OPS = 0, 1, 2, 3, 4
 LV_SIZE = LV_OPS + 2 * Q
-N_LEVELS = 5
+LEVEL_PRIORITY = (-1.0, 10.0, 20.0, 30.0, 40.0, 75.0, 100.0)
+N_LEVELS = len(LEVEL_PRIORITY)
 M_LV = 20
 # event queue: time, priority, robot, bearing, distance, energy, aux (fault / bullet heading), sequence
 E_TIME, E_PRIO, E_J, E_BEAR, E_DIST, E_EN, E_AUX, E_SEQ = range(8)
 E_SIZE = 8
 N_EVQ = 24
 M_EVQ = M_LV + N_LEVELS * LV_SIZE
-M_STATIC = M_EVQ + N_EVQ * E_SIZE  # kept across rounds (Corners' corner)
-M_SIZE = M_STATIC + 2
+M_STATIC = M_EVQ + N_EVQ * E_SIZE  # kept across rounds: Corners' corner, then the next two
+# EventManager's interruptible flag of the scanned-robot priority and the value rescan() restores: the event
+# manager outlives the round (EventManager.reset leaves the flags), so a robot that died in scan() inside its
+# onScannedRobot starts the next round with the flag set
+M_INTR, M_INTR_ORIG = M_STATIC + 1, M_STATIC + 2
+M_SAVE = M_STATIC + 3  # stop(): saved distance, body, gun, radar remaining (proxy fields: kept across rounds)
+M_SIZE = M_STATIC + 7
+M_ROUND_START = ((M_STOPPED, 1.0), (M_TOPT, -1.0))  # per-round memory that does not start at 0
 MAX_EVENT_STACK = 2  # Robocode EventManager: events older than 2 turns are dropped
 
 # play(): battle chunks per worker thread (a thread on a free core takes more when the other core is busy)
 _CHUNKS_PER_THREAD = 4
-P_SCAN, P_BULLET, P_WALL, P_ROBOT = 10.0, 20.0, 30.0, 40.0
-DEG = math.pi / 180.0
+P_SCAN, P_BULLET, P_WALL, P_ROBOT, P_MESSAGE, P_WIN = 10.0, 20.0, 30.0, 40.0, 75.0, 100.0
+DEG = math.pi / 180.0  # == Math.toRadians(1) (java.lang.Math.DEGREES_TO_RADIANS)
+RAD_TO_DEG = 57.29577951308232  # java.lang.Math.RADIANS_TO_DEGREES (Math.toDegrees)
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _deg(r):
+    """Radians as the robot API reports degrees (ScannedRobotEvent.getBearing, Robot.getGunHeading: r*180/PI)."""
+    return r * 180.0 / math.pi
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _heading_deg(h):
+    """Robot.getHeading(): 180*h/PI, wrapped into [0, 360)."""
+    d = 180.0 * h / math.pi
+    while d < 0:
+        d += 360.0
+    while d >= 360.0:
+        d -= 360.0
+    return d
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _rad(d):
+    """Math.toRadians: the degree methods (turnRight, turnGunRight, ...) hand the peer d * DEGREES_TO_RADIANS."""
+    return d * DEG
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _normal_relative_deg(a):
+    """Utils.normalRelativeAngleDegrees: a % 360 into [-180, 180)."""
+    a = np.fmod(a, 360.0)
+    if a >= 0:
+        return a if a < 180 else a - 360
+    return a if a >= -180 else a + 360
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _level_of(prio):
+    """Execution level of a handler priority."""
+    for lv in range(1, N_LEVELS):
+        if LEVEL_PRIORITY[lv] == prio:
+            return lv
+    return 0
 
 
 def bot_kind(name: str | None) -> int:
@@ -137,7 +191,7 @@ def _refill_main(kind, mem, b, i, heading, width, height, others):
         amount = max(width, height)
         if first:
             mem[b, i, M_VAR] = 0.0  # peek
-            _m(mem, b, i, O_TURN, -np.fmod(heading, math.pi / 2))  # turnLeft(heading % 90)
+            _m(mem, b, i, O_TURN, -_rad(np.fmod(_heading_deg(heading), 90.0)))  # turnLeft(getHeading() % 90)
             _m(mem, b, i, O_MOVE, amount)
             _m(mem, b, i, O_SETMAXV, -1.0)  # marker: peek = true
             _m(mem, b, i, O_GUN, 90 * DEG)
@@ -152,12 +206,12 @@ def _refill_main(kind, mem, b, i, heading, width, height, others):
             mem[b, i, M_VAR] = 0.0  # count
             mem[b, i, M_VAR + 1] = 10.0  # gunTurnAmt (deg)
             mem[b, i, M_VAR + 2] = -1.0  # tracked robot
-        _m(mem, b, i, O_GUN, mem[b, i, M_VAR + 1] * DEG)
+        _m(mem, b, i, O_GUN, _rad(mem[b, i, M_VAR + 1]))
         _m(mem, b, i, O_SETMAXV, -3.0)  # marker: count bookkeeping after the turn
     elif kind == K_RAMFIRE:
         if first:
             mem[b, i, M_VAR] = 1.0  # turnDirection
-        _m(mem, b, i, O_TURN, 5 * DEG * mem[b, i, M_VAR])
+        _m(mem, b, i, O_TURN, _rad(5 * mem[b, i, M_VAR]))
     elif kind == K_FIRE:
         if first:
             mem[b, i, M_VAR] = 50.0  # dist
@@ -168,7 +222,7 @@ def _refill_main(kind, mem, b, i, heading, width, height, others):
             mem[b, i, M_VAR + 1] = 3.0  # gunIncrement
             mem[b, i, M_VAR + 2] = others
             corner = mem[b, i, M_STATIC]
-            _m(mem, b, i, O_TURN, normal_relative_angle(corner * DEG - heading))
+            _m(mem, b, i, O_TURN, _rad(_normal_relative_deg(corner - _heading_deg(heading))))
             _m(mem, b, i, O_SETMAXV, -4.0)  # stopWhenSeeRobot = true
             _m(mem, b, i, O_MOVE, 5000.0)
             _m(mem, b, i, O_TURN, -90 * DEG)
@@ -177,7 +231,7 @@ def _refill_main(kind, mem, b, i, heading, width, height, others):
         else:
             # 30 x turnGunLeft(gunIncrement) as one gun op of 90 deg would differ in scan timing only
             # slightly; keep the 3-degree steps through a counter
-            _m(mem, b, i, O_GUN, -mem[b, i, M_VAR + 1] * DEG)
+            _m(mem, b, i, O_GUN, -_rad(mem[b, i, M_VAR + 1]))
             _m(mem, b, i, O_SETMAXV, -5.0)  # marker: count the step, flip after 30
     elif kind == K_CRAZY:
         _m(mem, b, i, O_SETMOVE, 40000.0)
@@ -188,6 +242,14 @@ def _refill_main(kind, mem, b, i, heading, width, height, others):
         _m(mem, b, i, O_WAITTURN, 0.0)
         _m(mem, b, i, O_SETTURN, 180 * DEG)
         _m(mem, b, i, O_WAITTURN, 0.0)
+    elif kind == K_TRACKFIRE:
+        _m(mem, b, i, O_GUN, 10 * DEG)
+    elif kind == K_LEADER:
+        _m(mem, b, i, O_SETRADAR, _rad(10000.0))
+        _m(mem, b, i, O_MOVE, 100.0)
+        _m(mem, b, i, O_MOVE, -100.0)
+    elif kind == K_DROID:  # run() returns at once; the robot then executes every turn, handling events
+        _m(mem, b, i, O_EXECUTE, 0.0)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -215,6 +277,12 @@ def _marker(kind, mem, b, i, code):
             mem[b, i, M_VAR + 1] *= -1
     elif code == -6.0:
         mem[b, i, M_VAR + 4] = 1.0  # Crazy movingForward
+    elif code == -7.0:  # Tracker.onWin: for (i = 0; i < 50; i++) { turnRight(30); turnLeft(30); }
+        mem[b, i, M_VAR + 5] += 1
+        if mem[b, i, M_VAR + 5] < 50:
+            base = M_LV + (N_LEVELS - 1) * LV_SIZE  # the win handler's level: its loop body again
+            mem[b, i, base + LV_POS] = 0
+            mem[b, i, base + LV_START] = 0
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -247,8 +315,18 @@ def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, heading, rem, gun_eq_radar):
+def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, heading, rem, gun_eq_radar, heat, energy):
     """Write an operation's commands; True if it takes the turn (blocking)."""
+    if op == O_EXECUTE:
+        return True
+    if op == O_SETRADAR:
+        cmd[b, i, 3] = val
+        return False
+    if op == O_FIRECOOL:  # TrackFire: if (getGunHeat() == 0) fire(min(val, getEnergy() - .1))
+        if heat > 0.0:
+            return False
+        cmd[b, i, 4] = max(min(val, energy - 0.1), 0.1)  # setFire clamps the power up to 0.1
+        return True
     if op == O_MOVE:
         cmd[b, i, 0] = val
         return True
@@ -350,13 +428,19 @@ def _before(mem, b, i, k, m):
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def _enqueue(mem, b, i, x, y, h, energy, alive, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-             ev_hitby_bearing):
+def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
+             ev_hitby, ev_hitby_bearing, hr, has_hr):
     """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns."""
     n = x.shape[1]
-    j = ev_robot[b, i]
-    if j >= 0:
-        _add_event(mem, b, i, P_ROBOT, j, ev_robot_bearing[b, i], 0.0, energy[b, j], 1.0 if ev_fault[b, i] else 0.0)
+    if has_hr:  # one HitRobotEvent per collision, in the engine's order (RobotPeer.checkRobotCollision)
+        for k in range(min(int(hr[b, 0, i]), HIT_ROBOT_SLOTS)):
+            _add_event(mem, b, i, P_ROBOT, hr[b, 1 + 4 * k, i], hr[b, 2 + 4 * k, i], 0.0, hr[b, 4 + 4 * k, i],
+                       hr[b, 3 + 4 * k, i])
+    else:
+        j = ev_robot[b, i]
+        if j >= 0:
+            _add_event(mem, b, i, P_ROBOT, j, ev_robot_bearing[b, i], 0.0, energy[b, j],
+                       1.0 if ev_fault[b, i] else 0.0)
     if ev_wall[b, i]:
         _add_event(mem, b, i, P_WALL, -1, 0.0, 0.0, 0.0, 0.0)
     if ev_hitby[b, i] > 0:
@@ -369,6 +453,14 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, scanned, ev_wall, ev_robot, ev_r
             dy = y[b, j2] - y[b, i]
             bearing = normal_relative_angle(math.atan2(dx, dy) - h[b, i])
             _add_event(mem, b, i, P_SCAN, j2, bearing, math.hypot(dx, dy), energy[b, j2], 0.0)
+    if mem[b, i, M_WON] == 0.0 and alive[b, i]:
+        won = True
+        for j2 in range(n):
+            if alive[b, j2] and team[b, j2] != team[b, i]:
+                won = False
+        if won:  # Battle.shutdownTurn: the survivors get a WinEvent in the turn the round is decided
+            mem[b, i, M_WON] = 1.0
+            _add_event(mem, b, i, P_WIN, -1, 0.0, 0.0, 0.0, 0.0)
     old = mem[b, i, M_CLOCK] - MAX_EVENT_STACK
     k = 0
     while k < int(mem[b, i, M_NEV]):
@@ -379,17 +471,37 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, scanned, ev_wall, ev_robot, ev_r
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+def _add_message(mem, b, d, time, px, py):
+    """A team message (a Point) for robot d, delivered at ``time`` (sent in one turn, read in the next)."""
+    n = int(mem[b, d, M_NEV])
+    if n >= N_EVQ:
+        return
+    e = M_EVQ + n * E_SIZE
+    mem[b, d, e + E_TIME] = time
+    mem[b, d, e + E_PRIO] = P_MESSAGE
+    mem[b, d, e + E_J] = -1
+    mem[b, d, e + E_BEAR] = px
+    mem[b, d, e + E_DIST] = py
+    mem[b, d, e + E_EN] = 0.0
+    mem[b, d, e + E_AUX] = 0.0
+    mem[b, d, e + E_SEQ] = n + time * N_EVQ
+    mem[b, d, M_NEV] = n + 1
+
+
+@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _head(mem, b, i):
     """Index of the first queued event in Robocode's order (-1: empty)."""
     best = -1
     for k in range(int(mem[b, i, M_NEV])):
+        if mem[b, i, M_EVQ + k * E_SIZE + E_TIME] > mem[b, i, M_CLOCK]:
+            continue  # a team message sent this turn: delivered in the next one
         if best < 0 or _before(mem, b, i, k, best):
             best = k
     return best
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
-def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
+def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, cmd):
     """Start the handler of queued event k (removed from the queue): its level and operations."""
     e = M_EVQ + k * E_SIZE
     prio = mem[b, i, e + E_PRIO]
@@ -402,27 +514,41 @@ def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
     mem[b, i, M_TOPSCAN] = 1.0 if prio == P_SCAN else 0.0
     mem[b, i, M_TOPB] = bearing
     _remove_event(mem, b, i, k)
-    _clear_level(mem, b, i, int(prio // 10), 1.0)
+    _clear_level(mem, b, i, _level_of(prio), 1.0)
     hb = h[b, i]
-    if prio == P_ROBOT:
+    bdeg = _deg(bearing)  # e.getBearing()
+    if prio == P_WIN:
+        if kind == K_TRACKER:  # onWin: 50 x (turnRight(30); turnLeft(30))
+            mem[b, i, M_VAR + 5] = 0.0
+            _h(mem, b, i, O_TURN, _rad(30.0))
+            _h(mem, b, i, O_TURN, -_rad(30.0))
+            _h(mem, b, i, O_SETMAXV, -7.0)
+        elif kind == K_TRACKFIRE:  # onWin: turnRight(36000)
+            _h(mem, b, i, O_TURN, _rad(36000.0))
+    elif prio == P_MESSAGE:
+        if kind == K_DROID:  # onMessageReceived(Point): aim the gun at the point, fire(3)
+            theta = math.atan2(bearing - x[b, i], dist - y[b, i]) * RAD_TO_DEG
+            _h(mem, b, i, O_GUN, _rad(_normal_relative_deg(theta - _deg(gh[b, i]))))
+            _h(mem, b, i, O_FIRE, 3.0)
+    elif prio == P_ROBOT:
         fault = aux == 1.0
         if kind == K_SPIN:
-            if -10 * DEG < bearing < 10 * DEG:
+            if -10 < bdeg < 10:
                 _h(mem, b, i, O_FIRE, 3.0)
             if fault:
-                _h(mem, b, i, O_TURN, 10 * DEG)
+                _h(mem, b, i, O_TURN, _rad(10.0))
         elif kind == K_WALLS:
-            _h(mem, b, i, O_MOVE, -100.0 if -math.pi / 2 < bearing < math.pi / 2 else 100.0)
+            _h(mem, b, i, O_MOVE, -100.0 if -90 < bdeg < 90 else 100.0)
         elif kind == K_TRACKER:
             mem[b, i, M_VAR + 2] = j
-            amt = normal_relative_angle(bearing + hb - rh[b, i])
-            mem[b, i, M_VAR + 1] = amt / DEG
-            _h(mem, b, i, O_GUN, amt)
+            amt = _normal_relative_deg(bdeg + (_heading_deg(hb) - _deg(rh[b, i])))
+            mem[b, i, M_VAR + 1] = amt
+            _h(mem, b, i, O_GUN, _rad(amt))
             _h(mem, b, i, O_FIRE, 3.0)
             _h(mem, b, i, O_MOVE, -50.0)
         elif kind == K_RAMFIRE:
-            mem[b, i, M_VAR] = 1.0 if bearing >= 0 else -1.0
-            _h(mem, b, i, O_TURN, bearing)
+            mem[b, i, M_VAR] = 1.0 if bdeg >= 0 else -1.0
+            _h(mem, b, i, O_TURN, _rad(bdeg))
             if e_energy > 16:
                 _h(mem, b, i, O_FIRE, 3.0)
             elif e_energy > 10:
@@ -435,7 +561,7 @@ def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
                 _h(mem, b, i, O_FIRE, 0.1)
             _h(mem, b, i, O_MOVE, 40.0)
         elif kind == K_FIRE:
-            _h(mem, b, i, O_GUN, normal_relative_angle(bearing + hb - gh[b, i]))
+            _h(mem, b, i, O_GUN, _rad(_normal_relative_deg(bdeg + _heading_deg(hb) - _deg(gh[b, i]))))
             _h(mem, b, i, O_FIRE, 3.0)
         elif kind == K_CRAZY and fault:
             _reverse(mem, b, i, cmd)
@@ -443,8 +569,10 @@ def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
         if kind == K_CRAZY:
             _reverse(mem, b, i, cmd)
     elif prio == P_BULLET:
+        if kind == K_LEADER:  # turnLeft(90 - e.getBearing())
+            _h(mem, b, i, O_TURN, -_rad(90 - bdeg))
         if kind == K_FIRE:  # turn perpendicular to the bullet, move, scan
-            _h(mem, b, i, O_TURN, normal_relative_angle(math.pi / 2 - (hb - aux)))
+            _h(mem, b, i, O_TURN, _rad(_normal_relative_deg(90 - (_heading_deg(hb) - aux * RAD_TO_DEG))))
             _h(mem, b, i, O_MOVE, mem[b, i, M_VAR])
             mem[b, i, M_VAR] *= -1
             _h(mem, b, i, O_SCAN, 0.0)
@@ -461,20 +589,36 @@ def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
                 return
             mem[b, i, M_VAR + 2] = j
             mem[b, i, M_VAR] = 0.0
-            amt = normal_relative_angle(bearing + hb - rh[b, i])
-            mem[b, i, M_VAR + 1] = amt / DEG
-            _h(mem, b, i, O_GUN, amt)
+            amt = _normal_relative_deg(bdeg + (_heading_deg(hb) - _deg(rh[b, i])))
+            mem[b, i, M_VAR + 1] = amt
+            _h(mem, b, i, O_GUN, _rad(amt))
             if dist > 150:
-                _h(mem, b, i, O_TURN, bearing)
+                _h(mem, b, i, O_TURN, _rad(bdeg))
                 _h(mem, b, i, O_MOVE, dist - 140)
             else:
                 _h(mem, b, i, O_FIREASSIST, 3.0)
                 if dist < 100:
-                    _h(mem, b, i, O_MOVE, -40.0 if -math.pi / 2 < bearing <= math.pi / 2 else 40.0)
+                    _h(mem, b, i, O_MOVE, -40.0 if -90 < bdeg <= 90 else 40.0)
                 _h(mem, b, i, O_SCAN, 0.0)
+        elif kind == K_TRACKFIRE:
+            bfg = _normal_relative_deg(_heading_deg(hb) + bdeg - _deg(gh[b, i]))  # bearing from the gun
+            _h(mem, b, i, O_GUN, _rad(bfg))
+            if abs(bfg) <= 3:
+                _h(mem, b, i, O_FIRECOOL, 3 - abs(bfg))
+            if bfg == 0:
+                _h(mem, b, i, O_SCAN, 0.0)
+        elif kind == K_LEADER:
+            if team[b, j] == team[b, i]:
+                return
+            eb = _heading_deg(hb) + bdeg
+            ex = x[b, i] + dist * math.sin(_rad(eb))
+            ey = y[b, i] + dist * math.cos(_rad(eb))
+            for d in range(x.shape[1]):  # broadcastMessage(new Point(ex, ey)) to the droids
+                if d != i and kinds[d] == K_DROID and team[b, d] == team[b, i] and alive[b, d]:
+                    _add_message(mem, b, d, mem[b, i, M_CLOCK] + 1, ex, ey)
         elif kind == K_RAMFIRE:
-            mem[b, i, M_VAR] = 1.0 if bearing >= 0 else -1.0
-            _h(mem, b, i, O_TURN, bearing)
+            mem[b, i, M_VAR] = 1.0 if bdeg >= 0 else -1.0
+            _h(mem, b, i, O_TURN, _rad(bdeg))
             _h(mem, b, i, O_MOVE, dist + 5)
             _h(mem, b, i, O_SCAN, 0.0)
         elif kind == K_FIRE:
@@ -494,13 +638,14 @@ def _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd):
 @njit(cache=True, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-                 ev_hitby_bearing, ev_died, width, height, cmd, rem):
+                 ev_hitby_bearing, ev_died, width, height, cmd, rem, hr, has_hr, heat):
     """One decision of battle b's scripted robots (their robot time between two turns).
 
     Each robot resumes inside the execute() of its running blocking call: EventManager.processEvents first
     (dispatch the head event while its priority is above the running level's; an equal one stops the loop
-    unless the running handler waits in scan(), which it then aborts), then the call's remaining-value test,
-    then the code after it up to the next blocking call.
+    unless the scanned-robot priority is interruptible, i.e. the handler waits in scan(): it is then aborted),
+    then the call's remaining-value test, then the code after it up to the next blocking call. A disabled
+    robot (energy 0) runs on: its moves and body turns are refused by the engine, the rest works.
     """
     n = x.shape[1]
     others = 0
@@ -514,15 +659,17 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
             if start > 0 and (start - others) / start < 0.75:
                 c = mem[b, i, M_STATIC] + 90
                 mem[b, i, M_STATIC] = -90.0 if c == 270 else c
-        if kind == K_NONE or kind == K_DUCK or not alive[b, i] or energy[b, i] == 0.0:
+        if kind == K_NONE or kind == K_DUCK or not (alive[b, i] or ev_died[b, i]):
             mem[b, i, M_CLOCK] += 1
             continue
+        # a robot that died this turn still wakes once: its blocking call returns and its code runs on to the
+        # next one, which throws DeathException (RobotPeer.executeImpl); commands of the dead are ignored
         rem[0] = dist_rem[b, i]
         rem[1] = body_rem[b, i]
         rem[2] = gun_rem[b, i]
         rem[3] = radar_rem[b, i]
-        _enqueue(mem, b, i, x, y, h, energy, alive, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-                 ev_hitby_bearing)
+        _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
+                 ev_hitby, ev_hitby_bearing, hr, has_hr)
         lv = _top_level(mem, b, i)
         process = True
         for _ in range(48):
@@ -533,14 +680,14 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
                     process = False
                     continue
                 prio = mem[b, i, M_EVQ + k * E_SIZE + E_PRIO]
-                cur = 10.0 * lv if lv > 0 else -1.0
+                cur = LEVEL_PRIORITY[lv]
                 if prio < cur:
                     process = False
                 elif prio == cur:
-                    pos = int(mem[b, i, base + LV_POS])
-                    if lv == 1 and mem[b, i, base + LV_START] == 1 and pos < int(mem[b, i, base + LV_LEN]) \
-                            and mem[b, i, base + LV_OPS + 2 * pos] == O_SCAN:
-                        # the handler waits in scan() (interruptible): EventInterruptedException ends it
+                    if lv == 1 and mem[b, i, M_INTR] == 1.0:
+                        # interruptible (the handler waits in scan(), or the flag survived the last round):
+                        # EventInterruptedException ends the handler
+                        mem[b, i, M_INTR] = 0.0
                         _clear_level(mem, b, i, lv, 0.0)
                         mem[b, i, M_TOPT] = -1.0
                         mem[b, i, M_TOPSCAN] = 0.0
@@ -548,8 +695,8 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
                     else:
                         process = False
                 else:
-                    _dispatch(kind, mem, b, i, k, h, gh, rh, energy, cmd)
-                    lv = int(prio // 10)
+                    _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, cmd)
+                    lv = _level_of(prio)
                     process = False
                 continue
             pos = int(mem[b, i, base + LV_POS])
@@ -557,6 +704,8 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
                 if lv == 0:
                     _refill_main(kind, mem, b, i, h[b, i], width, height, others - 1)
                 else:  # the handler returns into the processEvents loop of the level below
+                    if lv == 1:
+                        mem[b, i, M_INTR] = 0.0  # processEvents: setInterruptible(priority, false)
                     _clear_level(mem, b, i, lv, 0.0)
                     lv = _top_level(mem, b, i)
                     process = True
@@ -565,12 +714,18 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
             val = mem[b, i, base + LV_OPS + 2 * pos + 1]
             if mem[b, i, base + LV_START] == 1:
                 if _op_done(op, True, rem[0], rem[1], rem[2], rem[3]):
+                    if op == O_SCAN and lv == 1:
+                        mem[b, i, M_INTR] = mem[b, i, M_INTR_ORIG]  # rescan() restores the flag it found
                     mem[b, i, base + LV_POS] = pos + 1
                     mem[b, i, base + LV_START] = 0
                     continue
                 break  # still running: execute() again
             mem[b, i, base + LV_START] = 1
-            if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, h[b, i], rem, gh[b, i] == rh[b, i]):
+            if op == O_SCAN and lv == 1:  # rescan() inside onScannedRobot: interruptible while it executes
+                mem[b, i, M_INTR_ORIG] = mem[b, i, M_INTR]
+                mem[b, i, M_INTR] = 1.0
+            if _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, h[b, i], rem, gh[b, i] == rh[b, i],
+                      heat[b, i], energy[b, i]):
                 break
         mem[b, i, M_CLOCK] += 1
 
@@ -578,12 +733,32 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-              ev_hitby_bearing, ev_died, width, height, cmd, rem):
-    """One decision of every scripted robot (its robot time between two turns)."""
+              ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots=None, heat=None):
+    """One decision of every scripted robot (their robot time between two turns).
+
+    ``hit_robots``: the arena's per-collision HitRobot rows (``rf[:, EVROBN:EVROBN + 1 + 4 * HIT_ROBOT_SLOTS]``),
+    else one HitRobotEvent per robot and turn (the last); ``heat``: the gun heats (TrackFire reads them), else 0.
+    """
     for b in range(x.shape[0]):
-        _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem,
-                     maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-                     ev_hitby_bearing, ev_died, width, height, cmd, rem)
+        if hit_robots is None:
+            if heat is None:
+                _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
+                             radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing,
+                             ev_fault, ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, mem, False,
+                             assist)
+            else:
+                _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
+                             radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing,
+                             ev_fault, ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, mem, False,
+                             heat)
+        elif heat is None:
+            _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
+                         radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
+                         ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, assist)
+        else:
+            _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
+                         radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
+                         ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, heat)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -593,6 +768,7 @@ def _clear_memory(mem, b):
         for k in range(M_STATIC):
             mem[b, i, k] = 0.0
         mem[b, i, M_TOPT] = -1.0
+        mem[b, i, M_STOPPED] = 1.0  # the proxy starts each round as stopped: stop() saves nothing, resume() zeros
 
 
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
@@ -611,6 +787,7 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
     maxv, assist, ev_robb, ev_bulb = rf[:, K.MAXV], rf[:, K.ASSIST], rf[:, K.EVROBB], rf[:, K.EVBULB]
     alive, scan_req, ev_wall, ev_fault, ev_died = rb[:, K.ALIVE], rb[:, K.SCANREQ], rb[:, K.EVWALL], \
         rb[:, K.EVFAULT], rb[:, K.EVDIED]
+    hr, heat = rf[:, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[:, K.HEAT]
     team, ev_robot, ev_hitby = ri[:, K.TEAM], ri[:, K.EVROBOT], ri[:, K.EVHITBY]
     total = 0
     for b in range(b0, b1):
@@ -625,7 +802,7 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
                     cmd[b, i, 4] = 0.0
             _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist, body, gun, radar, maxv, assist,
                          scan_req, scanned, ev_wall, ev_robot, ev_robb, ev_fault, ev_hitby, ev_bulb, ev_died, width,
-                         height, cmd, rem)
+                         height, cmd, rem, hr, True, heat)
             if not bb[b, K.DONE]:
                 K.step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                                  placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
@@ -660,6 +837,10 @@ class ScriptedBots:
                 continue
             s.is_advanced[:, i] = name in ADVANCED_BOTS
             s.adjust_gun_for_body[:, i] = name == "Tracker"
+            droid = name == "MyFirstDroid"
+            if droid and not s.is_droid[0, i] and (s.time == 0).all():
+                s.energy[:, i] += 20.0  # a droid starts with 120 (the round was placed before the flag)
+            s.is_droid[:, i] = droid
             s.adjust_radar_for_body[:, i] = False
             s.adjust_radar_for_gun[:, i] = False
 
@@ -669,7 +850,8 @@ class ScriptedBots:
         keep = self.mem[idx, :, M_STATIC:].copy()
         self.mem[idx] = 0.0
         self.mem[idx, :, M_STATIC:] = keep
-        self.mem[idx, :, M_TOPT] = -1.0
+        for k, v in M_ROUND_START:
+            self.mem[idx, :, k] = v
         self._round[idx] = self.arena.state.round[idx]
 
     def sync_rounds(self) -> None:
@@ -746,12 +928,13 @@ class ScriptedBots:
                 s.gun_turn_remaining[r], s.radar_turn_remaining[r], s.max_velocity[r], s.fire_assist[r],
                 s.scan_request[r], s.scanned[r], s.ev_hit_wall[r], s.ev_hit_robot[r], s.ev_hit_robot_bearing[r],
                 s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r], s.ev_died[r],
-                float(self.arena.scenario.width), float(self.arena.scenario.height)), np.zeros(4)))
+                float(self.arena.scenario.width), float(self.arena.scenario.height)), np.zeros(4),
+                (s.packed["rf"][r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], s.gun_heat[r])))
 
     def _run(self, k: int, cmd: np.ndarray) -> None:
         """bots_step on battle chunk k."""
-        r, args, rem = self._chunks[k]
-        bots_step(*args, cmd[r], rem)
+        r, args, rem, tail = self._chunks[k]
+        bots_step(*args, cmd[r], rem, *tail)
 
 
 def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20, turns_after_end: int = 150,

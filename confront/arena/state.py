@@ -30,6 +30,12 @@ RF_FIELDS = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "e
              "box_x", "box_y", "distance_remaining", "body_turn_remaining", "gun_turn_remaining",
              "radar_turn_remaining", "max_velocity", "max_turn_rate", "fire_assist",
              "ev_hit_wall_bearing", "ev_hit_robot_bearing", "ev_hit_by_bullet_bearing")
+# every HitRobotEvent of the last turn in the engine's order (one per collision, RobotPeer.checkRobotCollision):
+# the count, then per slot the other robot, the bearing, the at-fault flag (1.0 / 0.0) and the other's energy
+# just after the hit; the single ev_hit_robot* fields keep the last one
+HIT_ROBOT_SLOTS = 4
+RF_FIELDS += ("ev_hit_robots",) + tuple(f"ev_hit_robot_{k}_{f}" for k in range(HIT_ROBOT_SLOTS)
+                                        for f in ("robot", "bearing", "fault", "energy"))
 RB_FIELDS = ("alive", "overdriving", "in_collision", "turned_radar_with_gun", "winner", "is_advanced",
              "is_leader", "is_droid", "adjust_gun_for_body", "adjust_radar_for_body", "adjust_radar_for_gun",
              "ev_hit_wall", "ev_at_fault", "ev_fired", "ev_died", "scan_request")

@@ -1,10 +1,11 @@
 """The scripted bots replay recorded engine rounds of Robocode's own sample robots turn by turn.
 
 Fixtures: tests/fixtures/traces/samples/*.jsonl, made by tests/fixtures/traces/samples/record_sample_bots.py (real
-sample.Tracker, sample.SpinBot, sample.RamFire; fixed start positions, -DRANDOMSEED=1). Tracker's
+sample robots; fixed start positions or the engine's seeded ones, ``-DRANDOMSEED``). Tracker's
 onScannedRobot blocks for many turns while scans queue up; the engine hands it the oldest queued event first
 (Event.compareTo: time before priority), so it aims from a scan one turn old, and a ram (priority 40) waits
-behind an unhandled older scan (priority 10) for a turn.
+behind an unhandled older scan (priority 10) for a turn. The issue-11 fixtures each show one engine rule the
+bots lacked before (see the ``what`` of each file's head line and ``FIXES`` below).
 """
 
 import json
@@ -19,26 +20,47 @@ from confront.arena.core import Arena
 from confront.arena.scenarios import get_scenario
 
 TRACES = Path(__file__).parents[1] / "fixtures" / "traces" / "samples"
+# fixture: the engine rule it needs (each failed before that rule was in the bots)
+FIXES = {
+    "sample_hit_robot_per_collision": "one HitRobotEvent per collision (two in a turn when both are at fault)",
+    "sample_disabled_runs": "a disabled robot's code runs on (gun turns, events, energy regained)",
+    "sample_interruptible_next_round": "the last wake of a dying robot; the interruptible flag outlives the round",
+    "sample_victory_dance": "the winner's onWin (Tracker's dance) in the turns after the end",
+    "sample_trackfire": "sample.TrackFire (degrees, gun heat, its onWin spin)",
+}
 
 
-def _replay(name: str) -> tuple[np.ndarray, np.ndarray]:
+def _load(name: str) -> tuple[dict, list[np.ndarray]]:
     lines = [json.loads(ln) for ln in (TRACES / f"{name}.jsonl").read_text().splitlines()]
-    head = lines[0]
-    eng = np.array([ln["robots"] for ln in lines[1:]])  # (T, R, 7)
+    rounds: dict[int, list] = {}
+    for ln in lines[1:]:
+        rounds.setdefault(ln.get("round", 0), []).append(ln["robots"])
+    return lines[0], [np.array(rounds[r]) for r in sorted(rounds)]  # per round (T, R, 7)
+
+
+def _replay(name: str) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    head, eng = _load(name)
     n = len(head["robots"])
-    sc = get_scenario("melee").replace(teams=(1,) * n, initial_positions=tuple(tuple(s) for s in head["starts"]),
+    starts = tuple(tuple(s) for s in head["starts"]) if head.get("starts") else None
+    sc = get_scenario("melee").replace(teams=tuple(head.get("teams", (1,) * n)), initial_positions=starts,
                                        turns_after_end=150, max_turns=100000)
     arena = Arena(sc, 1, seed=head["seed"], order="engine")
     bots = ScriptedBots(arena, head["robots"])
     cmd = arena.idle_commands()
     s = arena.state
-    sim = []
-    for _ in range(len(eng)):
-        bots.commands(cmd)
-        arena.step(cmd)
-        sim.append(np.stack([s.x[0], s.y[0], s.heading[0], s.gun_heading[0], s.radar_heading[0], s.velocity[0],
-                             s.energy[0]], 1))
-    return eng, np.array(sim)
+    sims = []
+    for rnd in eng:
+        sim = []
+        for _ in range(len(rnd)):
+            bots.commands(cmd)
+            arena.step(cmd)
+            sim.append(np.stack([s.x[0], s.y[0], s.heading[0], s.gun_heading[0], s.radar_heading[0],
+                                 s.velocity[0], s.energy[0]], 1))
+            if s.done[0]:
+                arena.reset(s.done.copy())
+                break
+        sims.append(np.array(sim))
+    return eng, sims
 
 
 def _diff(eng: np.ndarray, sim: np.ndarray) -> np.ndarray:
@@ -47,23 +69,42 @@ def _diff(eng: np.ndarray, sim: np.ndarray) -> np.ndarray:
     return d.max(axis=(1, 2))
 
 
+def _first_difference(eng: np.ndarray, sim: np.ndarray) -> int:
+    """First turn (1-based) where a robot differs by more than 1e-6; 0 if none."""
+    assert sim.shape == eng.shape, f"the simulator played {len(sim)} turns, the engine {len(eng)}"
+    bad = np.flatnonzero(_diff(eng, sim) > 1e-6)
+    return int(bad[0]) + 1 if bad.size else 0
+
+
 @pytest.mark.parametrize("name,turns", [("sample_tracker_spinbot", 400), ("sample_tracker_ramfire", 250)])
 def test_tracker_matches_the_engine_turn_by_turn(name, turns):
     eng, sim = _replay(name)
-    assert len(eng) == turns
-    # while both robots live (after a death the winner's victory dance is not scripted)
-    alive = (eng[:, :, 6] > 0).all(axis=1)
-    last = int(np.argmin(alive)) if not alive.all() else len(eng)
-    assert last > 200
-    bad = np.flatnonzero(_diff(eng[:last], sim[:last]) > 1e-6)
-    assert bad.size == 0, f"first difference in turn {bad[0] + 1}: engine {eng[bad[0]]}, simulator {sim[bad[0]]}"
+    assert len(eng) == 1 and len(eng[0]) == turns
+    assert _first_difference(eng[0], sim[0]) == 0
+
+
+@pytest.mark.parametrize("name", sorted(FIXES))
+def test_issue_11_rounds_replay_exactly(name):
+    """Whole engine rounds (the 150 turns after the end included), every robot within 1e-6 every turn."""
+    eng, sim = _replay(name)
+    assert len(sim) == len(eng)
+    for r, (e, s) in enumerate(zip(eng, sim, strict=True)):
+        assert _first_difference(e, s) == 0, f"{name} round {r}: {FIXES[name]}"
+
+
+def test_disabled_robot_turns_its_gun():
+    """Hand check of the fixture: RamFire at energy 0 still turns its gun, then regains energy."""
+    eng, _ = _replay("sample_disabled_runs")
+    e = eng[0][:, 1]
+    t0 = int(np.argmax(e[:, 6] == 0))
+    assert 300 < t0 and e[t0 + 1, 6] > 0 and (np.diff(e[t0:t0 + 10, 3]) != 0).any()
 
 
 def test_tracker_aims_from_the_older_scan():
     """Hand check of one turn of the fixture: Tracker's gun turn comes from the queued scan of the turn before."""
     eng, sim = _replay("sample_tracker_spinbot")
     # the simulator's Tracker turns its gun exactly as the engine's whenever it turns it at all
-    dg = np.diff(np.unwrap(eng[:200, 0, 3]))
-    dg_sim = np.diff(np.unwrap(sim[:200, 0, 3]))
+    dg = np.diff(np.unwrap(eng[0][:200, 0, 3]))
+    dg_sim = np.diff(np.unwrap(sim[0][:200, 0, 3]))
     assert np.abs(dg).max() > 0.1
     np.testing.assert_allclose(dg_sim, dg, atol=1e-9)

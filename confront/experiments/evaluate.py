@@ -108,6 +108,11 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     learner, _ = load_model(run)
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
+    from confront.arena.bots import BOT_NAMES
+
+    for name in names:
+        if name != "td" and name not in BOT_NAMES:
+            raise click.UsageError(f"unknown opponent {name!r} in --opponents: use td or {', '.join(BOT_NAMES)}")
     seeds = disjoint_seeds(seed, sim_seeds, rounds)
     lines = [f"| opponent | rounds | score ratio (simulator) | simulator, {sim_seeds} seeds (min-max) "
              "| score ratio (robocode) | difference |", "|---|---:|---:|---:|---:|---:|"]

@@ -28,10 +28,10 @@ import click
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.arena.scenarios import Scenario, get_scenario, load_scenario
+from confront.arena.scenarios import Scenario, get_scenario, load_scenario, scenario_names
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.state import SCORE_PARTS
-from confront.config import load_toml, to_dict
+from confront.config import ConfigError, load_toml, to_dict
 from confront.engine.java_build import cache_root
 from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.learning.base import Learner, Transition
@@ -47,8 +47,12 @@ __all__ = ["train_run", "print_summary", "build_learner", "load_model", "save_mo
 # -- building blocks ---------------------------------------------------------------------------------------------
 
 def scenario_of(name: str) -> Scenario:
-    """A named scenario or a scenario TOML file."""
-    return load_scenario(name) if name.endswith(".toml") else get_scenario(name)
+    """A named scenario or a scenario TOML file (a ConfigError naming it when it is neither)."""
+    try:
+        return load_scenario(name) if name.endswith(".toml") else get_scenario(name)
+    except (OSError, ValueError, TypeError, RecursionError) as exc:  # TOML and Unicode errors are ValueErrors
+        raise ConfigError(f"scenario {name!r} cannot be used ({str(exc).splitlines()[0][:200]}): give one of "
+                          f"{', '.join(scenario_names())} or a scenario .toml file") from None
 
 
 def smdp_config(cfg: ExperimentConfig) -> SMDPConfig:

@@ -1,10 +1,11 @@
 """Sample-robot battles in the simulator and in the real engine: score shares and identical rounds.
 
 Usage: ``python benchmarks/sample_shares.py [--rounds 100] [--seeds 1,2,3] [--only NAME,...] [--out FILE]``.
-Each matchup is one battle of ``rounds`` rounds with ``-DRANDOMSEED=seed`` in the engine (CPU constant 10 ms)
-and one seeded simulator battle (the engine's start positions and random order). Prints, per matchup and seed,
-each contestant's score share in both and how many rounds are identical (same length and the same score parts
-for every robot); once a round differs, the battles' random draws part and later rounds differ too.
+Each matchup is one battle of ``rounds`` rounds with ``-DRANDOMSEED=seed`` in the engine (CPU constant
+``--cpu-ms``, default 50 ms: no skipped turns on a busy machine) and one seeded simulator battle (the engine's
+start positions and random order). Prints, per matchup and seed, each contestant's score share in both and
+how many rounds are identical (same length and the same score parts for every robot); once a round differs,
+the battles' random draws part and later rounds differ too.
 """
 
 from __future__ import annotations
@@ -86,10 +87,10 @@ def simulate(m: Matchup, rounds: int, seed: int) -> tuple[np.ndarray, list[int],
     return s.score_total[0].copy(), lengths, per_round
 
 
-def engine(m: Matchup, rounds: int, seed: int) -> tuple[dict, list[int], list[np.ndarray], float]:
+def engine(m: Matchup, rounds: int, seed: int, cpu_ms: float) -> tuple[dict, list[int], list[np.ndarray], float]:
     """One seeded engine battle: the run's summary, round lengths, per-round robot scores, wall seconds."""
     t = time.time()
-    run = run_battle(m.spec(rounds), EngineOptions(seed=seed, cpu_constant_ms=10.0, timeout_s=3600))
+    run = run_battle(m.spec(rounds), EngineOptions(seed=seed, cpu_constant_ms=cpu_ms, timeout_s=3600))
     wall = time.time() - t
     per_round, last = [], np.zeros(len(m.robots))
     for rs in run.summary["round_scores"]:
@@ -112,6 +113,7 @@ def main() -> int:
     ap.add_argument("--seeds", default="1,2,3")
     ap.add_argument("--only", default="")
     ap.add_argument("--out", default="")
+    ap.add_argument("--cpu-ms", type=float, default=50.0, help="engine CPU constant: generous, so no turn is skipped")
     args = ap.parse_args()
     seeds = [int(x) for x in args.seeds.split(",")]
     only = [x for x in args.only.split(",") if x]
@@ -120,7 +122,7 @@ def main() -> int:
             continue
         for seed in seeds:
             sim_tot, sim_len, sim_rounds = simulate(m, args.rounds, seed)
-            summ, eng_len, eng_rounds, wall = engine(m, args.rounds, seed)
+            summ, eng_len, eng_rounds, wall = engine(m, args.rounds, seed, args.cpu_ms)
             eng_tot = np.array([r["score"]["total"] for r in summ["robots"]])
             same = 0
             for a, b, pa, pb in zip(sim_len, eng_len, sim_rounds, eng_rounds, strict=False):

@@ -95,10 +95,11 @@ def aim(x: np.ndarray, y: np.ndarray, gun_heading: np.ndarray, radar_heading: np
 
 
 def remember(memory: np.ndarray, arena: Arena) -> None:
-    """Add this turn's radar scans of ``arena`` to ``memory`` (B, 3 or 7, R, R), see observe.remember_scans."""
+    """Add this turn's radar scans of ``arena`` to ``memory`` (B, 3 or 9, R, R), see observe.remember_scans."""
     s = arena.state
     for b in range(arena.n_battles):
-        remember_scans(s.scanned[b], s.x[b], s.y[b], s.energy[b], s.heading[b], s.velocity[b], memory[b])
+        remember_scans(s.scanned[b], s.x[b], s.y[b], s.energy[b], s.heading[b], s.velocity[b], float(s.time[b]),
+                       memory[b])
 
 
 def known_targets(view: tuple[np.ndarray, ...], team: np.ndarray, rule: TargetRule = "nearest") -> np.ndarray:

@@ -263,21 +263,28 @@ reward_eq35_scalar = njit(cache=True)(reward_eq35)  # the same rule compiled for
 
 @njit(cache=True)
 def remember_scans(scanned: np.ndarray, x: np.ndarray, y: np.ndarray, e: np.ndarray, h: np.ndarray, v: np.ndarray,
-                   memory: np.ndarray) -> None:
+                   time: float, memory: np.ndarray) -> None:
     """Store, for one battle, what each robot's radar saw this turn: memory[:, i, j] = (x, y, energy) of j
     where scanned[i, j] (the values of a ScannedRobotEvent: the scan comes after every robot moved). A memory
-    of 7 rows (:mod:`confront.arena.tank`) also keeps heading, velocity, the energy drop since i's previous
-    scan of j this round and the scanned flag."""
+    of 9 rows (:mod:`confront.arena.tank`) also keeps heading, velocity, the energy drop since i's previous
+    scan of j this round, the scanned flag, the turn rate since that scan (within the +-10 deg/turn of
+    Rules.MAX_TURN_RATE) and the scan time."""
     n = x.shape[0]
-    full = memory.shape[0] >= 7
+    full = memory.shape[0] >= 9
+    max_rate = np.pi / 18.0
     for i in range(n):
         for j in range(n):
             if scanned[i, j]:
                 if full:
-                    memory[5, i, j] = memory[2, i, j] - e[j] if memory[6, i, j] > 0 else 0.0
+                    seen = memory[6, i, j] > 0
+                    memory[5, i, j] = memory[2, i, j] - e[j] if seen else 0.0
+                    dt = time - memory[8, i, j]
+                    dh = float_mod(h[j] - memory[3, i, j] + np.pi, 2 * np.pi) - np.pi
+                    memory[7, i, j] = min(max(dh / dt, -max_rate), max_rate) if seen and dt > 0 else 0.0
                     memory[3, i, j] = h[j]
                     memory[4, i, j] = v[j]
                     memory[6, i, j] = 1.0
+                    memory[8, i, j] = time
                 memory[0, i, j] = x[j]
                 memory[1, i, j] = y[j]
                 memory[2, i, j] = e[j]

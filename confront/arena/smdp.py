@@ -194,7 +194,7 @@ class TeamBattleEnv:
         b, r = self.n_battles, self.n_robots
         if opponent_actions not in ("same", "paper"):
             raise ValueError(f"opponent_actions must be 'same' or 'paper', got {opponent_actions!r}")
-        self._move = np.zeros((b, r, 2))
+        self._move = np.zeros((b, r, 3))  # distance, body turn, 1 = turn relative to the target's bearing
         self._power = np.zeros((b, r))
         self._chosen = np.full((b, r), -1, dtype=np.int64)  # the step's chosen target robot (-1: by rule)
         tank = self.config.tank
@@ -468,16 +468,18 @@ C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_LEAD, C_RE
 
 def _action_tables(cfg: SMDPConfig, learner: np.ndarray, team: np.ndarray, opponent_actions: str
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Action tables (2, A, 4) of (distance, body turn, fire power, target slot) rows, 0 = the learners',
+    """Action tables (2, A, 5) of (distance, body turn, fire power, target slot, relative turn) rows, 0 = the
+    learners',
     1 = the caller-driven opponents'; each robot's table (R,) (-1: scripted); actions per table (2,).
     Fire power 0 = by distance (the paper's controller), -1 = hold fire; slot -1 = the target rule's."""
     dist, turn = move_commands(np.arange(N_MOVES), cfg.control)
     a = np.arange(cfg.paper_actions)
     powers = np.asarray(cfg.fire_powers)[a // N_MOVES] if cfg.fire_power_actions else np.zeros(a.size)
-    paper = np.stack([dist[a % N_MOVES], turn[a % N_MOVES], powers, np.full(a.size, -1.0)], axis=1)
+    paper = np.stack([dist[a % N_MOVES], turn[a % N_MOVES], powers, np.full(a.size, -1.0), np.zeros(a.size)],
+                     axis=1)
     ours = action_table(cfg.tank) if cfg.tank is not None else paper
     theirs = paper if opponent_actions == "paper" else ours
-    tables = np.zeros((2, max(len(ours), len(theirs)), 4))
+    tables = np.zeros((2, max(len(ours), len(theirs)), 5))
     tables[0, :len(ours)], tables[1, :len(theirs)] = ours, theirs
     space = np.where(learner, np.where(team == 0, 0, 1), -1).astype(np.int64)
     return tables, space, np.array([len(ours), len(theirs)], dtype=np.int64)
@@ -502,6 +504,7 @@ def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndar
             row = tables[max(sp, 0), a]
             move[b, i, 0] = row[0]
             move[b, i, 1] = row[1]
+            move[b, i, 2] = row[4]
             power[b, i] = row[2]
             k = int(row[3])
             chosen[b, i] = slots[b, i, k] if sp >= 0 and 0 <= k < slots.shape[2] else -1
@@ -601,6 +604,9 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     # moves are written once at the start of the SMDP step (set* semantics), then kept
                     cmd[b, i, 0] = move[b, i, 0] if t == 0 else np.nan
                     cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
+                    if t == 0 and move[b, i, 2] > 0 and tg >= 0:  # turn relative to the target's bearing
+                        bearing = np.arctan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
+                        cmd[b, i, 1] = _relative(bearing + move[b, i, 1] - rf[b, K.H, i])
                     cmd[b, i, 2] = np.nan
                     cmd[b, i, 3] = np.nan
                     cmd[b, i, 4] = 0.0
@@ -608,8 +614,9 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                         tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
                         if tg >= 0 and ctrl[C_LEAD] > 0 and sensing == 1:
                             aim_power = power[b, i] if power[b, i] > 0 else 2.0
+                            rate = memory[b, 7, i, tg] if ctrl[C_LEAD] > 1 else 0.0
                             tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, 3, i, tg],
-                                                memory[b, 4, i, tg], float(bi[b, K.TIME] - scan_time[b, i, tg]),
+                                                memory[b, 4, i, tg], rate, float(bi[b, K.TIME] - scan_time[b, i, tg]),
                                                 aim_power, width, height)
                         controller_turn(rf, b, i, tg, tx, ty, ctrl, power[b, i], cmd)
                 else:
@@ -634,7 +641,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
         K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                      placements, placements_total, cmd, params, scratch_i, scratch_f)
         for b in range(b0, b1):
-            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V], memory[b])
+            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],
+                           float(bi[b, K.TIME]), memory[b])
             if margin:
                 for i in range(n):
                     if not learner[i]:

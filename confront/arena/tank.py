@@ -33,13 +33,16 @@ Nothing names an opponent. The slot map ``slots`` (B, R, K) keeps which robot fi
 action's target slot can be resolved to a robot.
 
 Tank actions: four heads, one joint integer ``((d * n_turns + t) * n_fire + f) * K + k``: a move distance
-(px, + ahead) and a body turn (rad, + clockwise) set once at the start of the T-turn step, a fire power
+(px, + ahead) and a body turn set once at the start of the T-turn step (``turn_mode="target"``: the turn
+that puts the body at that angle (rad, + clockwise) to the target's bearing, so 0 faces it and +-90 deg
+circles it; ``"body"`` or no known target: a turn by that angle), a fire power
 (0 = hold fire), and the enemy slot to target. The fixed gun/radar controller (paper §6.1) then aims at
 that target every turn, optionally leading it linearly (``lead_point``), and fires with the chosen power
 when the gun is on target and cold.
 
 Scan memory rows (``memory`` (B, MEMORY_ROWS, R, R), ``[b, :, i, j]`` = robot j at robot i's last scan of
-it): x, y, energy, heading, velocity, energy drop since the previous scan, 1 when scanned this round.
+it): x, y, energy, heading, velocity, energy drop since the previous scan, 1 when scanned this round, its
+turn rate between the last two scans (rad/turn, within +-10 deg), the scan's time.
 """
 
 from __future__ import annotations
@@ -54,14 +57,14 @@ from numba import njit
 __all__ = ["TankSpace", "MEMORY_ROWS", "n_features", "tank_view_row", "tank_view_kernel", "lead_point",
            "action_table", "FEATURE_NAMES"]
 
-MEMORY_ROWS = 7  # x, y, energy, heading, velocity, energy drop, scanned this round
-M_X, M_Y, M_E, M_H, M_V, M_DROP, M_SEEN = range(MEMORY_ROWS)
+MEMORY_ROWS = 9  # x, y, energy, heading, velocity, energy drop, scanned this round, turn rate, scan time
+M_X, M_Y, M_E, M_H, M_V, M_DROP, M_SEEN, M_TURN, M_TIME = range(MEMORY_ROWS)
 OWN_FEATURES = 11
 ENEMY_FEATURES = 9
 MATE_FEATURES = 5
 MAX_AGE = 50.0  # turns: older scans read as 1
 WALL_MARGIN = 18.0  # half a robot: a tank's centre never gets closer to a wall (Robocode's 36 px body)
-LEADS = {"none": 0, "linear": 1}
+LEADS = {"none": 0, "linear": 1, "circular": 2}
 
 
 def n_features(k: int, m: int) -> int:
@@ -89,11 +92,13 @@ class TankSpace:
     """The tank actions' values and the tank view's slots."""
 
     distances: tuple[float, ...] = (-150.0, -50.0, 0.0, 50.0, 150.0)  # px, + ahead
-    turns_deg: tuple[float, ...] = (-90.0, -30.0, 0.0, 30.0, 90.0)  # body turn, + clockwise
+    turns_deg: tuple[float, ...] = (-90.0, -45.0, 0.0, 45.0, 90.0)  # + clockwise, see turn_mode
+    turn_mode: Literal["target", "body"] = "target"  # the body ends at this angle to the target's bearing,
+    # or turns by it (also "target" mode without a known target)
     fire_powers: tuple[float, ...] = (0.0, 1.0, 2.0, 3.0)  # 0 = hold fire
     enemy_slots: int = 4  # K
     mate_slots: int = 3  # M
-    lead: Literal["none", "linear"] = "linear"
+    lead: Literal["none", "linear", "circular"] = "circular"
 
     def __post_init__(self) -> None:
         for name in ("distances", "turns_deg", "fire_powers"):
@@ -108,6 +113,8 @@ class TankSpace:
             raise ValueError(f"tank.enemy_slots must be an integer in 1..16, got {self.enemy_slots!r}")
         if not isinstance(self.mate_slots, int) or not 0 <= self.mate_slots <= 16:
             raise ValueError(f"tank.mate_slots must be an integer in 0..16, got {self.mate_slots!r}")
+        if self.turn_mode not in ("target", "body"):
+            raise ValueError(f"tank.turn_mode must be 'target' or 'body', got {self.turn_mode!r}")
         if self.lead not in LEADS:
             raise ValueError(f"tank.lead must be one of {', '.join(LEADS)}, got {self.lead!r}")
 
@@ -128,7 +135,8 @@ class TankSpace:
 
 
 def action_table(space: TankSpace) -> np.ndarray:
-    """(n_actions, 4) rows of (distance, body turn, fire power (-1 = hold), target slot) per joint action."""
+    """(n_actions, 5) rows of (distance, body turn, fire power (-1 = hold), target slot, 1 when the turn is
+    relative to the target's bearing) per joint action."""
     nd, nt, nf, nk = space.dims
     a = np.arange(space.n_actions)
     k, f = a % nk, (a // nk) % nf
@@ -136,21 +144,29 @@ def action_table(space: TankSpace) -> np.ndarray:
     power = np.asarray(space.fire_powers, dtype=np.float64)[f]
     return np.stack([np.asarray(space.distances, dtype=np.float64)[d],
                      np.radians(np.asarray(space.turns_deg, dtype=np.float64))[t],
-                     np.where(power > 0, power, -1.0), k.astype(np.float64)], axis=1)
+                     np.where(power > 0, power, -1.0), k.astype(np.float64),
+                     np.full(a.size, 1.0 if space.turn_mode == "target" else 0.0)], axis=1)
 
 
 @njit(cache=True)
-def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, age: float, power: float,
-               width: float, height: float) -> tuple[float, float]:
-    """Where to aim at an enemy last scanned at (mx, my) heading mh at velocity mv ``age`` turns ago: linear
-    lead, the enemy keeps its heading and speed while our bullet of ``power`` flies (speed 20 - 3 p,
-    Rules.getBulletSpeed); clipped to where a robot's centre can be; 10 fixed-point iterations."""
+def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, rate: float, age: float,
+               power: float, width: float, height: float) -> tuple[float, float]:
+    """Where to aim at an enemy last scanned at (mx, my) heading mh at velocity mv ``age`` turns ago, turning
+    ``rate`` rad/turn (0 = linear lead): it keeps speed and turn rate while our bullet of ``power`` flies
+    (speed 20 - 3 p, Rules.getBulletSpeed), on a circle (x += v/w (cos h0 - cos(h0 + w t)), y += v/w
+    (sin(h0 + w t) - sin h0), Robocode's heading clockwise from north); clipped to where a robot's centre can
+    be; 10 fixed-point iterations."""
     speed = 20.0 - 3.0 * power
-    s, c = np.sin(mh), np.cos(mh)
     px, py, t = mx, my, 0.0
     for _ in range(10):
-        px = min(max(mx + s * mv * (age + t), WALL_MARGIN), width - WALL_MARGIN)
-        py = min(max(my + c * mv * (age + t), WALL_MARGIN), height - WALL_MARGIN)
+        tau = age + t
+        if abs(rate) < 1e-9:
+            ox, oy = np.sin(mh) * mv * tau, np.cos(mh) * mv * tau
+        else:
+            ox = mv / rate * (np.cos(mh) - np.cos(mh + rate * tau))
+            oy = mv / rate * (np.sin(mh + rate * tau) - np.sin(mh))
+        px = min(max(mx + ox, WALL_MARGIN), width - WALL_MARGIN)
+        py = min(max(my + oy, WALL_MARGIN), height - WALL_MARGIN)
         t = np.hypot(px - x, py - y) / speed
     return px, py
 

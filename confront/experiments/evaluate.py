@@ -265,7 +265,7 @@ def replay_cli(source: Path, out: Path | None) -> None:
 
 
 BENCHES = {"sim": "sim_throughput.py", "learner": "learner_throughput.py", "env": "env_throughput.py",
-           "bridge": "bridge_throughput.py", "reproduce": "reproduce_time.py"}
+           "bridge": "bridge_throughput.py", "reproduce": "reproduce_time.py", "train": "train_throughput.py"}
 
 
 def bench_cli(what: str) -> None:

@@ -118,12 +118,16 @@ class TankSection:
     decision_turns: int = field(5, ge=1, le=100, doc="T: turns each tank action is held")
     distances: tuple[float, ...] = field((-150.0, -50.0, 0.0, 50.0, 150.0), ge=-1000, le=1000,
                                          doc="move distances, px (+ ahead)")
-    turns_deg: tuple[float, ...] = field((-90.0, -30.0, 0.0, 30.0, 90.0), ge=-360, le=360,
-                                         doc="body turns, degrees (+ clockwise)")
+    turns_deg: tuple[float, ...] = field((-90.0, -45.0, 0.0, 45.0, 90.0), ge=-360, le=360,
+                                         doc="body angles, degrees (+ clockwise), see turn_mode")
+    turn_mode: Literal["target", "body"] = field(
+        "target", doc="target: the body ends at that angle to the target's bearing (0 faces it, +-90 circles it); "
+        "body: turn by that angle")
     fire_powers: tuple[float, ...] = field((0.0, 1.0, 2.0, 3.0), ge=0.0, le=3.0, doc="bullet powers, 0 = hold fire")
     enemy_slots: int = field(4, ge=1, le=16, doc="K nearest scanned enemies in the view (and target choices)")
     mate_slots: int = field(3, ge=0, le=16, doc="M nearest team-mates in the view")
-    lead: Literal["none", "linear"] = field("linear", doc="gun lead of the fixed controller")
+    lead: Literal["none", "linear", "circular"] = field(
+        "circular", doc="gun lead of the fixed controller: none, linear, or circular (the turn rate between scans)")
     reward: Literal["score", "eq35"] = field("score", doc="team's Robocode score margin per turn, or Eq. 35")
 
 

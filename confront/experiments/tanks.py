@@ -43,8 +43,9 @@ __all__ = ["train_tanks", "tank_space", "smdp_tank_config", "build_pool", "dodge
 def tank_space(cfg: ExperimentConfig) -> TankSpace:
     """The config's tank actions and view."""
     t = cfg.tank
-    return TankSpace(distances=tuple(t.distances), turns_deg=tuple(t.turns_deg), fire_powers=tuple(t.fire_powers),
-                     enemy_slots=t.enemy_slots, mate_slots=t.mate_slots, lead=t.lead)
+    return TankSpace(distances=tuple(t.distances), turns_deg=tuple(t.turns_deg), turn_mode=t.turn_mode,
+                     fire_powers=tuple(t.fire_powers), enemy_slots=t.enemy_slots, mate_slots=t.mate_slots,
+                     lead=t.lead)
 
 
 def smdp_tank_config(cfg: ExperimentConfig) -> SMDPConfig:
@@ -66,21 +67,24 @@ def random_policy(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator)
 
 
 def dodge_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
-    """A hand-written stochastic dodge on the tank view: turn the body perpendicular to the nearest known
-    enemy, drive full distance ahead or back at random each step, fire power 2 at it (the tank actions)."""
+    """A hand-written stochastic dodge on the tank view: the body perpendicular to the nearest known enemy,
+    full distance ahead or back at random each step, fire power 2 at it (the tank actions)."""
     turns = np.radians(np.asarray(space.turns_deg))
     dists = np.asarray(space.distances)
     powers = np.asarray(space.fire_powers)
     far = int(np.argmax(dists)), int(np.argmin(dists))
     fire = int(np.argmin(np.abs(powers - 2.0)))
+    side = int(np.argmin(np.abs(np.abs(turns) - np.pi / 2)))  # the angle nearest 90 deg (turn_mode "target")
 
     def act(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         o = OWN_FEATURES
-        rel = np.arctan2(feats[:, o + 1], feats[:, o + 2])  # bearing of slot 0 from the heading
-        want = (rel + np.pi / 2 + np.pi) % np.pi - np.pi / 2  # nearest perpendicular: rel -+ 90 deg in [-90, 90)
-        want = (want - np.pi / 2 + np.pi) % (2 * np.pi) - np.pi
-        want = np.where(np.abs(want) > np.pi / 2, want - np.sign(want) * np.pi, want)
-        t = np.argmin(np.abs(turns[None, :] - want[:, None]), axis=1)
+        if space.turn_mode == "target":
+            t = np.full(len(disc), side)
+        else:
+            rel = np.arctan2(feats[:, o + 1], feats[:, o + 2])  # bearing of slot 0 from the heading
+            cand = (np.stack([rel + np.pi / 2, rel - np.pi / 2]) + np.pi) % (2 * np.pi) - np.pi
+            want = np.where(np.abs(cand[0]) < np.abs(cand[1]), cand[0], cand[1])  # the smaller perpendicular turn
+            t = np.argmin(np.abs(turns[None, :] - want[:, None]), axis=1)
         d = np.where(rng.random(len(disc)) < 0.5, far[0], far[1])
         f = np.where(feats[:, o] > 0, fire, int(np.argmin(powers)))
         return np.ravel_multi_index((d, t, f, np.zeros_like(d)), space.dims)

@@ -1,0 +1,56 @@
+"""End-to-end training throughput of the recommended learner (PPO tanks against the league): agent-decisions
+per second with the env, inference and updates all counted, and where the time goes. Prints a table, then
+one JSON line. No assertions (figures go to docs/learning.md)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+
+from confront.experiments.spec import load_experiment
+from confront.experiments.tanks import TankTrainer
+
+
+def measure(opponents: list[str], battles: int, updates: int) -> dict[str, float | int | str]:
+    """Run ``updates`` PPO updates after one warm-up update (compiles kernels); figures over the timed ones."""
+    ov = [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", 'learner.kind="ppo"']
+    trainer = TankTrainer(load_experiment("demo", ov))
+    trainer.update()  # warm-up: numba kernels, torch
+    d0, t0, c0 = trainer.decisions, time.perf_counter(), time.process_time()
+    env = upd = 0.0
+    for _ in range(updates):
+        row = trainer.update()
+        dt = row["decisions"] / max(row["decisions_per_s"], 1e-9)
+        env += row["env_fraction"]
+        upd += row["update_fraction"]
+    wall = time.perf_counter() - t0
+    n = trainer.decisions - d0
+    return {"league": ",".join(opponents), "agents": trainer.pool.n_agents, "decisions": n,
+            "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
+            "env_fraction": env / updates, "update_fraction": upd / updates, "wall_s": wall, "_dt": dt}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--updates", type=int, default=5)
+    ap.add_argument("--battles", type=int, default=16)
+    args = ap.parse_args()
+    rows = [
+        measure(["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"], args.battles * 2,
+                args.updates),
+        measure(["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"], args.battles, args.updates),
+    ]
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    print("| league | agents | decisions/s | decisions/CPU-s | env | update |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for r in rows:
+        print(f"| {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | {r['decisions_per_cpu_s']:,.0f} | "
+              f"{r['env_fraction']:.0%} | {r['update_fraction']:.0%} |")
+    print(json.dumps({"bench": "train", "load": os.getloadavg()[0],
+                      "rows": [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]}))
+
+
+if __name__ == "__main__":
+    main()

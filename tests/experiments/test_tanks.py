@@ -1,0 +1,106 @@
+"""PPO tanks: the tank view's hand-computed entries, a short training run that learns, exact resume."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from confront import checkpoint as ck
+from confront.arena.smdp import SMDPConfig, TeamBattleEnv
+from confront.arena.tank import OWN_FEATURES, TankSpace, action_table, lead_point, tank_view_row
+from confront.experiments.spec import load_experiment
+from confront.experiments.tanks import TankTrainer, evaluate_tanks, share_by_opponent, train_tanks
+from confront.runs import Run
+
+
+def test_view_hand_computed() -> None:
+    # robot 0 at (100, 100) heading east; enemy 1 last scanned at (100, 400) (north of it), 3 turns ago,
+    # heading west at 8 px/turn, energy 50 after 80 (a drop of 30 > 3: clipped); mate 2 at (400, 100)
+    x, y = np.array([100.0, 300.0, 400.0]), np.array([100.0, 300.0, 100.0])
+    h = np.array([math.pi / 2, 0.0, 0.0])
+    mem = np.zeros((9, 3, 3))
+    mem[:, 0, 1] = [100.0, 400.0, 50.0, 3 * math.pi / 2, 8.0, 30.0, 1.0, 0.0, 7.0]
+    seen = np.full((3, 3), -1, dtype=np.int32)
+    seen[0, 1] = 7
+    out, slots = np.zeros(11 + 9 * 2 + 5), np.zeros(2, dtype=np.int64)
+    tank_view_row(x, y, h, np.array([-4.0, 0, 0]), np.array([60.0, 80, 90]), np.array([1.5, 0, 0]),
+                  np.ones(3, bool), np.array([0, 1, 0]), 0, mem, seen, 10.0, 800.0, 600.0, 2, 1, out, slots)
+    np.testing.assert_allclose(out[:11], [100 / 800, 100 / 600, 700 / 800, 500 / 600, 1.0, math.cos(math.pi / 2),
+                                          -0.5, 0.6, 0.5, 1.0, 1.0], atol=1e-12)
+    e = out[OWN_FEATURES:OWN_FEATURES + 9]
+    # bearing north = -90 deg from an east heading; moving west = lateral -(8)/8 (anticlockwise around us)
+    np.testing.assert_allclose(e, [1.0, -1.0, 0.0, 300 / 1000, -1.0, 0.0, 0.5, 3 / 50, 1.0], atol=1e-12)
+    assert slots.tolist() == [1, -1] and (out[20:29] == 0).all()
+    np.testing.assert_allclose(out[29:], [1.0, 0.0, 1.0, 300 / 1000, 0.9], atol=1e-12)  # mate straight ahead
+
+
+def test_lead_point_linear_and_circular() -> None:
+    # a target 200 px north moving east at 8 px/turn, scanned now; power 3 bullets fly 11 px/turn
+    px, py = lead_point(400.0, 100.0, 400.0, 300.0, math.pi / 2, 8.0, 0.0, 0.0, 3.0, 800.0, 600.0)
+    t = math.hypot(px - 400, py - 100) / 11.0
+    assert py == pytest.approx(300.0) and px == pytest.approx(400 + 8 * t)
+    # turning: after tau turns on the circle of radius v / w
+    w = math.radians(5)
+    cx, cy = lead_point(400.0, 100.0, 400.0, 300.0, math.pi / 2, 8.0, w, 0.0, 3.0, 800.0, 600.0)
+    tau = math.hypot(cx - 400, cy - 100) / 11.0
+    assert cx == pytest.approx(400 + 8 / w * (math.cos(math.pi / 2) - math.cos(math.pi / 2 + w * tau)))
+    assert cy == pytest.approx(300 + 8 / w * (math.sin(math.pi / 2 + w * tau) - 1.0)) and cy < 300
+
+
+def test_action_table_decodes_the_heads() -> None:
+    space = TankSpace()
+    table = action_table(space)
+    a = np.ravel_multi_index((4, 0, 0, 2), space.dims)
+    np.testing.assert_allclose(table[a], [150.0, math.radians(-90.0), -1.0, 2.0, 1.0])  # hold fire: -1
+
+
+def test_hold_fire_never_fires_and_chosen_target_is_aimed() -> None:
+    space = TankSpace(fire_powers=(0.0,), distances=(0.0,), turns_deg=(0.0,))
+    env = TeamBattleEnv("4v4", n_battles=2, seed=1, opponents="SittingDuck",
+                        config=SMDPConfig(turns_per_step=5, tank=space, reward="score"))
+    env.reset()
+    for _ in range(20):
+        env.step(np.zeros((2, 8), dtype=np.int64))
+    assert (env.arena.state.energy[:, :4] == 100.0).all()  # nobody fired, nobody was hit
+
+
+def _cfg(tmp_path, opponents: str, **kw: str) -> object:
+    ov = ['learner.kind="ppo"', f"league.opponents={json.dumps(opponents.split(','))}", "ppo.rollout_steps=16",
+          "train.session_rounds=8", f"train.checkpoint_every={kw.pop('ckpt', 1000)}", "ppo.hidden=32"]
+    ov += [f"{k}={v}" for k, v in kw.items()]
+    return load_experiment("demo", ov)
+
+
+def test_training_against_sittingduck_learns(tmp_path) -> None:
+    cfg = _cfg(tmp_path, "1v1:SittingDuck", **{"league.battles": "16", "train.rounds": "200", "ppo.lr": "0.002"})
+    trainer = TankTrainer(cfg)
+    before = evaluate_tanks(cfg, trainer.ppo, rounds=8)["1v1:SittingDuck"]
+    while trainer.rounds_done < 200:
+        trainer.update()
+    after = evaluate_tanks(cfg, trainer.ppo, rounds=8)["1v1:SittingDuck"]
+    turns_first = np.mean([r["turns"] for r in trainer.rows[:32]])
+    turns_last = np.mean([r["turns"] for r in trainer.rows[-32:]])
+    assert after["share"] > 0.9 and after["win_rate"] == 1.0
+    assert turns_last < 0.8 * turns_first  # it learned to destroy the sitting duck sooner
+    assert before["win_rate"] <= after["win_rate"]
+
+
+def test_resume_after_a_kill_is_exact(tmp_path) -> None:
+    cfg = _cfg(tmp_path, "1v1:SpinBot,4v4:dodge", ckpt="6", **{"league.battles": "2", "train.rounds": "14"})
+    full = train_tanks(cfg, Run.create(tmp_path / "full", {}), progress=False)
+    part = Run.create(tmp_path / "part", {})
+    trainer = TankTrainer(cfg)
+    while trainer.rounds_done < 6:
+        trainer.update()
+    arrays, meta = trainer.state()
+    ck.save(part.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)  # then the process "dies"
+    resumed = train_tanks(cfg, part, resume=True, progress=False)
+    assert resumed["rounds"] == full["rounds"]
+    a, b = Run(tmp_path / "full").read_table("rounds"), Run(tmp_path / "part").read_table("rounds")
+    assert [r["score_ours"] for r in a] == [r["score_ours"] for r in b]
+    wa = np.load(tmp_path / "full" / "model" / "actor.npz")
+    wb = np.load(tmp_path / "part" / "model" / "actor.npz")
+    for k in wa.files:
+        np.testing.assert_array_equal(wa[k], wb[k])
+    assert set(share_by_opponent(a)) == {"1v1:SpinBot", "4v4:dodge"}

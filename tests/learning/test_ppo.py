@@ -1,0 +1,96 @@
+"""PPO: GAE by hand, the factorised joint action, the team critic's input, learning a known problem, state."""
+
+import numpy as np
+import pytest
+
+from confront.learning.ppo import PPO, PPOConfig, Rollout, gae, greedy_joint, team_mean
+
+
+def test_gae_hand_computed() -> None:
+    # one agent, 3 steps, gamma 0.5, lambda 0.5; the episode ends at step 1, a new one starts at step 2
+    r = np.array([[1.0], [2.0], [3.0]])
+    v = np.array([[0.5], [1.0], [2.0]])
+    done = np.array([[False], [True], [False]])
+    active = np.ones((3, 1), bool)
+    adv, ret = gae(r, v, done, active, np.array([4.0]), 0.5, 0.5)
+    d2 = 3.0 + 0.5 * 4.0 - 2.0  # 3
+    d1 = 2.0 - 1.0  # 1 (terminal: no bootstrap)
+    d0 = 1.0 + 0.5 * 1.0 - 0.5  # 1
+    a1 = d1
+    a0 = d0 + 0.25 * a1
+    np.testing.assert_allclose(adv[:, 0], [a0, a1, d2])
+    np.testing.assert_allclose(ret, adv + v)
+
+
+def test_gae_inactive_steps_are_zero_and_cut() -> None:
+    r = np.array([[1.0], [5.0], [1.0]])
+    v = np.array([[0.0], [9.0], [0.0]])
+    done = np.array([[True], [False], [False]])  # died at step 0, dead (inactive) at step 1, new round at 2
+    active = np.array([[True], [False], [True]])
+    adv, _ = gae(r, v, done, active, np.array([0.0]), 0.9, 0.9)
+    np.testing.assert_allclose(adv[:, 0], [1.0, 0.0, 1.0])
+
+
+def test_joint_action_is_mixed_radix() -> None:
+    dims = (5, 5, 4, 4)
+    logits = np.full((1, sum(dims)), -1.0)
+    for start, pick in zip(np.cumsum((0,) + dims[:-1]), (3, 1, 2, 0), strict=True):
+        logits[0, start + pick] = 1.0
+    assert greedy_joint(logits, dims)[0] == ((3 * 5 + 1) * 4 + 2) * 4 + 0
+    assert greedy_joint(np.zeros((1, 18)), dims)[0] == 0  # ties go to the lower index
+
+
+def test_team_mean_over_living() -> None:
+    obs = np.array([[1.0, 0.0], [3.0, 2.0], [5.0, 5.0]], np.float32)
+    out = team_mean(obs, np.array([0, 0, 1]), 2, np.array([True, True, False]))
+    np.testing.assert_allclose(out[0], [2.0, 1.0], atol=1e-5)
+    np.testing.assert_allclose(out[2], [5.0, 5.0], atol=1e-5)  # nobody alive: the plain mean
+
+
+def _bandit_rollout(ppo: PPO, rng: np.random.Generator, s: int = 8, n: int = 64) -> Rollout:
+    """A contextual bandit: the sign of feature 0 says which of head 0's two actions pays 1."""
+    obs = rng.choice([-1.0, 1.0], size=(s, n, 2)).astype(np.float32)
+    heads, logp, value = np.zeros((s, n, 2), np.int64), np.zeros((s, n), np.float32), np.zeros((s, n), np.float32)
+    reward = np.zeros((s, n))
+    for t in range(s):
+        _, h, lp, v = ppo.act(obs[t], obs[t])
+        heads[t], logp[t], value[t] = h, lp, v
+        reward[t] = (h[:, 0] == (obs[t, :, 0] > 0)).astype(float)
+    return Rollout(obs, obs.copy(), heads, logp, value, reward, np.ones((s, n), bool), np.ones((s, n), bool),
+                   np.zeros(n, np.float32))
+
+
+def test_learns_a_contextual_bandit() -> None:
+    rng = np.random.default_rng(0)
+    ppo = PPO(2, (2, 3), PPOConfig(hidden=16, lr=3e-3, team_critic=False, ent_coef=0.0), seed=0)
+    first = _bandit_rollout(ppo, rng).reward.mean()
+    for _ in range(40):
+        ppo.update(_bandit_rollout(ppo, rng))
+    obs = np.array([[1.0, 1.0], [-1.0, 1.0]], np.float32)
+    joint, heads, _, _ = ppo.act(obs, explore=False)
+    assert first < 0.7
+    assert heads[:, 0].tolist() == [1, 0]  # head 0 follows the sign of feature 0
+    assert _bandit_rollout(ppo, rng).reward.mean() > 0.95
+
+
+def test_state_dict_resumes_exactly() -> None:
+    rng = np.random.default_rng(1)
+    a = PPO(2, (2, 3), PPOConfig(hidden=8, team_critic=False), seed=3)
+    a.update(_bandit_rollout(a, rng))
+    b = PPO(2, (2, 3), PPOConfig(hidden=8, team_critic=False), seed=99)
+    b.load_state_dict({k: v.copy() for k, v in a.state_dict().items()})
+    ro = _bandit_rollout(PPO(2, (2, 3), PPOConfig(hidden=8, team_critic=False), seed=7), np.random.default_rng(5))
+    a.update(ro)
+    b.update(ro)
+    for k, v in a.state_dict().items():
+        np.testing.assert_array_equal(v, b.state_dict()[k], err_msg=k)
+    obs = np.ones((4, 2), np.float32)
+    np.testing.assert_array_equal(a.act(obs)[0], b.act(obs)[0])  # the sampling generator too
+
+
+def test_bad_state_and_config_refused() -> None:
+    a = PPO(2, (2, 3), PPOConfig(hidden=8))
+    with pytest.raises(ValueError, match="does not fit"):
+        a.load_state_dict(PPO(3, (2, 3), PPOConfig(hidden=8)).state_dict())
+    with pytest.raises(ValueError, match="ppo.rollout_steps"):
+        PPOConfig(rollout_steps=0)

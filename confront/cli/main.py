@@ -212,7 +212,8 @@ def replay(source: Path, out: Path | None) -> None:
 
 
 @cli.command()
-@click.argument("what", type=click.Choice(["sim", "learner", "env", "bridge", "reproduce", "train", "all"]), default="sim")
+@click.argument("what", type=click.Choice(["sim", "learner", "env", "bridge", "reproduce", "train", "all"]),
+                default="sim")
 def bench(what: str) -> None:
     """Run a benchmark script from benchmarks/ and print its table."""
     from confront.experiments.evaluate import bench_cli

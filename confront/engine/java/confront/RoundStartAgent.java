@@ -8,7 +8,6 @@ import java.lang.instrument.Instrumentation;
 import java.nio.charset.StandardCharsets;
 import java.security.ProtectionDomain;
 import java.util.concurrent.atomic.AtomicBoolean;
-import java.util.jar.JarFile;
 
 /**
  * Java agent that removes the engine's lost wake-up at round start (every robot, sample or ours).
@@ -29,14 +28,9 @@ public final class RoundStartAgent implements ClassFileTransformer {
     private RoundStartAgent() {
     }
 
+    /** Installs the transformer; the runner's class path (the compiled classes) also serves waitUnlessAsleep
+     *  to the engine's own class loader, which asks its parent for classes outside the engine. */
     public static void premain(String args, Instrumentation inst) {
-        try {
-            String jar = RoundStartAgent.class.getProtectionDomain().getCodeSource().getLocation().getPath();
-            // the engine's own class loader must see waitUnlessAsleep: put the agent's jar on the boot path
-            inst.appendToBootstrapClassLoaderSearch(new JarFile(jar));
-        } catch (IOException | RuntimeException e) {
-            System.err.println("RoundStartAgent: " + e);
-        }
         inst.addTransformer(new RoundStartAgent());
     }
 

@@ -76,7 +76,8 @@ M_STATIC = M_EVQ + N_EVQ * E_SIZE  # kept across rounds: Corners' corner, then t
 # onScannedRobot starts the next round with the flag set
 M_INTR, M_INTR_ORIG = M_STATIC + 1, M_STATIC + 2
 M_SAVE = M_STATIC + 3  # stop(): saved distance, body, gun, radar remaining (proxy fields: kept across rounds)
-M_SIZE = M_STATIC + 7
+M_MATES = M_STATIC + 7  # bit j set: isTeammate(name of robot j) is true for this robot (see teammate_masks)
+M_SIZE = M_STATIC + 8
 M_ROUND_START = ((M_STOPPED, 1.0), (M_TOPT, -1.0))  # per-round memory that does not start at 0
 MAX_EVENT_STACK = 2  # Robocode EventManager: events older than 2 turns are dropped
 
@@ -126,6 +127,25 @@ def _level_of(prio):
         if LEVEL_PRIORITY[lv] == prio:
             return lv
     return 0
+
+
+def teammate_masks(names: list[str | None], teams: list[int]) -> list[int]:
+    """Per robot, the robots whose name its ``isTeammate`` accepts (bit j), as the engine names them.
+
+    Battle.createPeers names a robot "class (robot index + 1)" when its class occurs more than once in the
+    battle, but lists team members as "class (count of that class so far)": with several robots of one class
+    the two disagree, so a leader can take some of its own droids for enemies (MyFirstTeam: the droid at
+    battle index 4 is "MyFirstDroid (5)", its team lists "(1)" to "(4)").
+    """
+    cls = [n or f"?{i}" for i, n in enumerate(names)]
+    total = {c: cls.count(c) for c in cls}
+    own = [c + (f" ({i + 1})" if total[c] > 1 else "") for i, c in enumerate(cls)]
+    listed = [f"{c} ({cls[:i + 1].count(c)})" for i, c in enumerate(cls)]
+    masks = []
+    for i in range(len(cls)):
+        mates = {listed[m] for m in range(len(cls)) if teams[m] == teams[i] and listed[m] != own[i]}
+        masks.append(sum(1 << j for j in range(len(cls)) if own[j] == own[i] or own[j] in mates))
+    return masks
 
 
 def bot_kind(name: str | None) -> int:
@@ -608,7 +628,7 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
             if bfg == 0:
                 _h(mem, b, i, O_SCAN, 0.0)
         elif kind == K_LEADER:
-            if team[b, j] == team[b, i]:
+            if (int(mem[b, i, M_MATES]) >> j) & 1:  # isTeammate(e.getName())
                 return
             eb = _heading_deg(hb) + bdeg
             ex = x[b, i] + dist * math.sin(_rad(eb))
@@ -825,6 +845,7 @@ class ScriptedBots:
         self.kinds = np.array([bot_kind(n) for n in names], dtype=np.int64)
         self._bots = np.flatnonzero(self.kinds != K_NONE)
         self.mem = np.zeros((arena.n_battles, arena.n_robots, M_SIZE))
+        self.mem[:, :, M_MATES] = teammate_masks(self.names, list(arena.state.team[0]))
         self._apply_flags()
         self._round = arena.state.round.copy()
         self._chunk_args()

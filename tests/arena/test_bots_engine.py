@@ -27,6 +27,7 @@ FIXES = {
     "sample_interruptible_next_round": "the last wake of a dying robot; the interruptible flag outlives the round",
     "sample_victory_dance": "the winner's onWin (Tracker's dance) in the turns after the end",
     "sample_trackfire": "sample.TrackFire (degrees, gun heat, its onWin spin)",
+    "sample_myfirstteam": "sampleteam.MyFirstTeam: the leader's Point messages read by the droids a turn later",
 }
 
 

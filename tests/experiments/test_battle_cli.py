@@ -34,4 +34,4 @@ def test_battle_is_one_battle_unless_split_and_records_its_first_round(tmp_path:
     assert data["turn"][:3] == [0, 1, 2] and data["names"] == ["Tracker (0)", "RamFire (1)"]
     assert (out.parent / "first.gif").stat().st_size > 10_000 and (out.parent / "first.html").exists()
     bad = runner.invoke(cli, ["battle", "--robots", "Tracker,RamFire", "--battles", "0"])
-    assert bad.exit_code == 2 and "--battles must be >= 1" in bad.output
+    assert bad.exit_code == 2 and "'--battles': 0 is not in the range x>=1" in bad.output

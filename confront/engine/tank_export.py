@@ -2,11 +2,12 @@
 standalone Robocode robot ``confront.TankBot``, with its Java inference (``TankModel.java``).
 :class:`TankPolicy` is the Python twin: the same view (the simulator's ``tank_view_row``, fed what the robot
 knows), the same greedy action and the same gun/radar controller (``smdp.controller_turn`` with
-``tank.lead_point``).
+``tank.lead_point``: no lead, linear, or circular with the turn rate of ``observe.remember_scans``).
 
 Policy file (text, data only): ``confront-tank 1``, ``key value`` lines (lists as space-separated values)
 and ``matrix NAME ROWS COLS`` blocks: ``w0 b0 w1 b1 ...``, weights as (out, in), tanh between layers, the
-last layer's outputs the logits of the four heads (distance, body turn, fire power, enemy slot) in order.
+last layer's outputs the logits of the five heads (distance, body turn, fire power, enemy slot, gun lead) in
+order.
 
 A run trained on the tank view is exported when its ``model/model.json`` has ``"kind": "ppo"``: the actor
 is ``model/actor.npz`` (``w0, b0, w1, b1, ...`` as (out, in), or a torch state dict's
@@ -36,11 +37,12 @@ from confront.engine.export import policy_data_source
 from confront.engine.install import EngineInstall, find_engine
 from confront.engine.java_build import compile_java
 
-__all__ = ["TankPolicy", "robot_view", "robot_target", "robot_control", "export_tank_robot", "is_tank_run",
-           "load_tank_policy", "TANK_CLASSES"]
+__all__ = ["TankPolicy", "robot_view", "robot_target", "robot_control", "body_turn", "turn_rate",
+           "export_tank_robot", "is_tank_run", "load_tank_policy", "TANK_CLASSES"]
 
 TANK_CLASSES = ("TankBot", "TankModel", "RoundStart")
-EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time
+EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time, turn rate
+MAX_RATE = math.pi / 18.0  # Rules.MAX_TURN_RATE, 10 deg/turn
 MateRow = Sequence[float]  # x, y, energy
 
 
@@ -62,6 +64,8 @@ def robot_view(own: Sequence[float], counts: Sequence[int], enemies: Sequence[En
         for r in range(6):
             memory[r, 0, j] = row[r]
         memory[6, 0, j] = 1.0
+        memory[7, 0, j] = row[7]
+        memory[8, 0, j] = row[6]
         seen[0, j] = int(row[6])
     for j, row in enumerate(mates, start=1 + ne):
         x[j], y[j], e[j] = row
@@ -93,18 +97,39 @@ def _relative(a: float) -> float:
     return float(float_mod(a + math.pi, 2 * math.pi)) - math.pi
 
 
-def robot_control(control: ControlConfig, lead: bool, x: float, y: float, gun_heading: float, radar_heading: float,
+def turn_rate(previous: EnemyRow | None, heading: float, time: float) -> float:
+    """An enemy's turn rate at a new scan (``observe.remember_scans``): its heading change since the previous
+    scan this round (``previous``, None: none) over the turns between them, within +-10 deg/turn."""
+    if previous is None or not time - previous[6] > 0:
+        return 0.0
+    return min(max(_relative(heading - previous[3]) / (time - previous[6]), -MAX_RATE), MAX_RATE)
+
+
+def body_turn(space: TankSpace, x: float, y: float, heading: float, enemies: Sequence[EnemyRow], target: int,
+              turn: float) -> float:
+    """The body turn commanded at a step's start for the action's ``turn`` (smdp._smdp_turns): with
+    ``turn_mode="target"`` and a target, the turn putting the body at that angle to the target's bearing from
+    its last scanned position, wrapped to [-pi, pi); else ``turn``."""
+    if space.turn_mode != "target" or target < 0:
+        return turn
+    row = enemies[target]
+    return _relative(math.atan2(row[0] - x, row[1] - y) + turn - heading)
+
+
+def robot_control(control: ControlConfig, lead: str, x: float, y: float, gun_heading: float, radar_heading: float,
                   gun_heat: float, energy: float, enemies: Sequence[EnemyRow], target: int, power: float,
                   time: float, width: float, height: float) -> tuple[float, float, float]:
     """(gun turn (NaN = keep), radar turn, fire power) of the controller (smdp.controller_turn) toward
-    ``enemies[target]`` with the linear lead (``lead_point``, bullet power ``power`` or 2 when not set);
-    ``power`` -1 holds fire, 0 picks it by distance band."""
+    ``enemies[target]`` with the step's ``lead`` (one of TankSpace.leads: "none", "linear", or "circular" with
+    the row's turn rate; ``lead_point``, bullet power ``power`` or 2 when not set); ``power`` -1 holds fire, 0
+    picks it by distance band."""
     if target < 0:
         return math.nan, 2 * math.pi, 0.0
     row = enemies[target]
     tx, ty = float(row[0]), float(row[1])
-    if lead:
-        tx, ty = lead_point(x, y, tx, ty, float(row[3]), float(row[4]), float(time - row[6]),
+    if lead != "none":
+        rate = float(row[7]) if lead == "circular" else 0.0
+        tx, ty = lead_point(x, y, tx, ty, float(row[3]), float(row[4]), rate, float(time - row[6]),
                             power if power > 0 else 2.0, float(width), float(height))
     dx, dy = tx - x, ty - y
     bearing = math.atan2(dx, dy)
@@ -184,7 +209,7 @@ class TankPolicy:
         return h
 
     def act(self, view: np.ndarray) -> int:
-        """Greedy joint action ``((d * nt + t) * nf + f) * K + k``: the first maximum of each head."""
+        """Greedy joint action (``np.ravel_multi_index`` over TankSpace.dims): the first maximum of each head."""
         z = self.logits(view)
         joint, off = 0, 0
         for n in self.space.dims:
@@ -192,10 +217,12 @@ class TankPolicy:
             off += n
         return joint
 
-    def decode(self, action: int) -> tuple[float, float, float, int]:
-        """(distance, body turn rad, fire power (-1 = hold), enemy slot) of a joint action (action_table)."""
-        d, t, p, k = action_table(self.space)[action]
-        return float(d), float(t), float(p), int(k)
+    def decode(self, action: int) -> tuple[float, float, float, int, str]:
+        """(distance, body turn rad (see body_turn), fire power (-1 = hold), enemy slot, gun lead) of a joint
+        action (action_table)."""
+        d, t, p, k = action_table(self.space)[action][:4]
+        lead = self.space.leads[int(np.unravel_index(action, self.space.dims)[-1])]
+        return float(d), float(t), float(p), int(k), lead
 
     # -- file ----------------------------------------------------------------------------------
     def to_text(self) -> str:
@@ -206,8 +233,9 @@ class TankPolicy:
             return " ".join(repr(float(x)) for x in v)
 
         lines = ["confront-tank 1", f"step_turns {self.step_turns}", f"distances {nums(s.distances)}",
-                 f"turns_deg {nums(s.turns_deg)}", f"fire_powers {nums(s.fire_powers)}",
-                 f"enemy_slots {s.enemy_slots}", f"mate_slots {s.mate_slots}", f"lead {s.lead}"]
+                 f"turns_deg {nums(s.turns_deg)}", f"turn_mode {s.turn_mode}",
+                 f"fire_powers {nums(s.fire_powers)}", f"enemy_slots {s.enemy_slots}",
+                 f"mate_slots {s.mate_slots}", f"leads {' '.join(s.leads)}"]
         for f in fields(ControlConfig):
             v = getattr(self.control, f.name)
             lines.append(f"{f.name} {int(v) if isinstance(v, bool) else repr(float(v))}")

@@ -7,6 +7,7 @@ import json
 import math
 import subprocess
 import zipfile
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -18,12 +19,14 @@ from confront.arena.tank import TankSpace
 from confront.engine.java_build import compile_java
 from confront.engine.tank_export import (
     TankPolicy,
+    body_turn,
     export_tank_robot,
     is_tank_run,
     load_tank_policy,
     robot_control,
     robot_target,
     robot_view,
+    turn_rate,
 )
 
 SPACE = TankSpace()
@@ -49,7 +52,8 @@ def _knowledge(env: TeamBattleEnv, b: int, i: int) -> dict:
         "counts": [int(sum(s.alive[b, j] for j in range(r) if team[j] != team[i])), int(sum(team != team[i])),
                    len(mates), int(sum(team == team[i]) - 1)],
         "ids": enemies,
-        "enemies": [[*(float(v) for v in env._memory[b, :6, i, j]), float(s.scan_time[b, i, j])] for j in enemies],
+        "enemies": [[*(float(v) for v in env._memory[b, :6, i, j]), float(s.scan_time[b, i, j]),
+                     float(env._memory[b, 7, i, j])] for j in enemies],
         "mates": [[float(s.x[b, j]), float(s.y[b, j]), float(s.energy[b, j])] for j in mates],
         "time": float(s.time[b]),
     }
@@ -75,25 +79,45 @@ def views() -> list[tuple[dict, np.ndarray, np.ndarray]]:
 
 
 @pytest.fixture(scope="module")
-def controls() -> list[tuple[dict, float, int, tuple[float, float, float]]]:
-    """(knowledge, step's fire power, chosen enemy row (-1 none), the simulator's (gun, radar, fire)) of every
-    living learning tank in turns of 4v4 battles with random tank actions held for one turn (T = 1)."""
+def recorded_turns() -> tuple[list[tuple], list[tuple[float, ...]]]:
+    """(knowledge, step's fire power, chosen enemy row (-1 none), the action's body turn, its lead, the
+    simulator's (body turn, gun, radar, fire)) of every living learning tank in turns of 4v4 battles with
+    random tank actions held for one turn (T = 1, so every turn starts a step); and
+    every scan's (seen before, previous heading, previous scan time, heading, time, the simulator's turn rate)."""
     env = _env(1, seed=21)
     env.reset()
     rng = np.random.default_rng(22)
-    out = []
+    out, rates = [], []
     for _ in range(300):
         a = rng.integers(0, env.n_actions, size=(2, 8))
         s = env.arena.state
         before = [(b, i, _knowledge(env, b, i), env.slots[b, i].copy()) for b in range(2) for i in range(4)
                   if s.alive[b, i] and not s.done[b]]
+        memory = env._memory.copy()
         env.step(a)
+        for b, i, j in zip(*np.nonzero(s.scanned), strict=True):
+            if not s.done[b]:
+                rates.append((float(memory[b, 6, i, j]), float(memory[b, 3, i, j]), float(memory[b, 8, i, j]),
+                              float(s.heading[b, j]), float(s.time[b]), float(env._memory[b, 7, i, j])))
         for b, i, k, slots in before:
-            _, _, power, slot = (float(v) for v in _table()[a[b, i]])
+            _, turn, power, slot = (float(v) for v in _table()[a[b, i]][:4])
             robot = slots[int(slot)]
             chosen = k["ids"].index(robot) if robot >= 0 and robot in k["ids"] else -1
-            out.append((k, power, chosen, tuple(float(v) for v in env._cmd[b, i, 2:5])))
-    return out
+            lead = SPACE.leads[int(np.unravel_index(a[b, i], SPACE.dims)[-1])]
+            out.append((k, power, chosen, turn, lead, tuple(float(v) for v in env._cmd[b, i, 1:5])))
+    return out, rates
+
+
+@pytest.fixture(scope="module")
+def controls(recorded_turns) -> list[tuple]:
+    """The controller's recorded turns (see recorded_turns)."""
+    return recorded_turns[0]
+
+
+@pytest.fixture(scope="module")
+def rates(recorded_turns) -> list[tuple[float, ...]]:
+    """The recorded scans' turn rates (see recorded_turns)."""
+    return recorded_turns[1]
 
 
 def _table() -> np.ndarray:
@@ -129,10 +153,11 @@ def test_twin_view_equals_the_simulator(views) -> None:
 
 def test_twin_controller_equals_the_simulator(controls) -> None:
     shots = led = none = held = chosen = 0
-    for k, power, c, (gun, radar, fire) in controls:
+    for k, power, c, turn, lead, (body, gun, radar, fire) in controls:
         x, y = k["own"][:2]
         tgt = robot_target(x, y, k["enemies"], c)
-        g, r, f = robot_control(ControlConfig(), SPACE.lead == "linear", x, y, *k["guns"], k["own"][5], k["own"][4],
+        assert body_turn(SPACE, x, y, k["own"][2], k["enemies"], tgt, turn) == pytest.approx(body, abs=1e-12), k
+        g, r, f = robot_control(ControlConfig(), lead, x, y, *k["guns"], k["own"][5], k["own"][4],
                                 k["enemies"], tgt, power, k["time"], *FIELD)
         assert (math.isnan(g) and math.isnan(gun)) or g == pytest.approx(gun, abs=1e-12), k
         assert r == pytest.approx(radar, abs=1e-12) and f == fire, k
@@ -140,8 +165,17 @@ def test_twin_controller_equals_the_simulator(controls) -> None:
         none += tgt < 0
         held += power < 0 and tgt >= 0
         chosen += c >= 0 and c != robot_target(x, y, k["enemies"], -1)
-        led += tgt >= 0 and k["enemies"][tgt][4] != 0
+        led += tgt >= 0 and lead == "circular" and k["enemies"][tgt][4] != 0 and k["enemies"][tgt][7] != 0
     assert min(shots, led, none, held, chosen) > 0, (shots, led, none, held, chosen)
+
+
+def test_twin_turn_rate_equals_the_simulator(rates) -> None:
+    turning = 0
+    for seen, prev_h, prev_t, h, time, rate in rates:
+        prev = [0.0, 0.0, 0.0, prev_h, 0.0, 0.0, prev_t, 0.0] if seen else None
+        assert turn_rate(prev, h, time) == pytest.approx(rate, abs=1e-15)
+        turning += rate != 0
+    assert turning > 0 and any(seen and time - prev_t > 1 for seen, _, prev_t, _, time, _ in rates)
 
 
 # -- Java against the twin ----------------------------------------------------------------------------
@@ -193,21 +227,35 @@ def test_java_greedy_actions_equal_python(install, views, tmp_path) -> None:
             np.testing.assert_allclose([float(z) for z in logits.split()], policy.logits(v), rtol=0, atol=1e-9)
             assert int(a) == policy.act(v)
             heads.add(policy.decode(int(a)))
-        assert len({h[0] for h in heads}) > 1 and len({h[3] for h in heads}) > 1  # several choices per head
+        assert all(len({h[i] for h in heads}) > 1 for i in range(5)), heads  # several choices per head
 
 
 @pytest.mark.engine
-def test_java_controller_equals_python(install, controls, tmp_path) -> None:
-    reqs = [f"C\t{_nums(k['own'][:2] + k['guns'] + [k['own'][5], k['own'][4], p, c, k['time'], *FIELD])}"
-            f"\t{_rows(k['enemies'])}" for k, p, c, _ in controls]
-    for line, (k, p, c, sim) in zip(_java(install, _policy(0), reqs, tmp_path), controls, strict=True):
-        gun, radar, fire, tgt = (float(x) for x in line.split())
+@pytest.mark.parametrize("lead", ["none", "linear", "circular"])
+def test_java_controller_equals_python(install, controls, tmp_path, lead) -> None:
+    code = {"none": 0, "linear": 1, "circular": 2}[lead]
+    reqs = [f"C\t{_nums(k['own'][:3] + k['guns'] + [k['own'][5], k['own'][4], p, c, turn, code, k['time'], *FIELD])}"
+            f"\t{_rows(k['enemies'])}" for k, p, c, turn, _, _ in controls]
+    out = _java(install, _policy(0), reqs, tmp_path)
+    for line, (k, p, c, turn, sim_lead, (sim_body, *sim)) in zip(out, controls, strict=True):
+        gun, radar, fire, tgt, body = (float(x) for x in line.split())
         x, y = k["own"][:2]
         assert int(tgt) == robot_target(x, y, k["enemies"], c)
-        g, r, f = robot_control(ControlConfig(), True, x, y, *k["guns"], k["own"][5], k["own"][4], k["enemies"],
+        assert abs(body - body_turn(SPACE, x, y, k["own"][2], k["enemies"], int(tgt), turn)) <= 1e-9, line
+        assert abs(body - sim_body) <= 1e-9, line  # the lead does not change the body turn
+        g, r, f = robot_control(ControlConfig(), lead, x, y, *k["guns"], k["own"][5], k["own"][4], k["enemies"],
                                 int(tgt), p, k["time"], *FIELD)
         assert (math.isnan(g) and math.isnan(gun)) or abs(gun - g) <= 1e-9, line
-        assert abs(radar - r) <= 1e-9 and fire == f == sim[2], line
+        assert abs(radar - r) <= 1e-9 and fire == f, line
+        if lead == sim_lead:
+            assert (math.isnan(sim[0]) and math.isnan(gun)) or abs(gun - sim[0]) <= 1e-9, line
+            assert abs(radar - sim[1]) <= 1e-9 and fire == sim[2], line
+
+
+@pytest.mark.engine
+def test_java_turn_rate_equals_the_simulator(install, rates, tmp_path) -> None:
+    out = _java(install, _policy(0), [f"R\t{_nums(r[:5])}" for r in rates], tmp_path)
+    assert max(abs(float(line) - r[5]) for line, r in zip(out, rates, strict=True)) <= 1e-15
 
 
 # -- the policy file and the run folder -----------------------------------------------------------------
@@ -222,10 +270,12 @@ def test_policy_from_state_and_checks() -> None:
     q = TankPolicy.from_state(torch_names, SPACE, step_turns=5)
     view = np.random.default_rng(0).uniform(-1, 1, SPACE.n_features)
     assert q.act(view) == p.act(view)
-    d, t, power, k = p.decode(p.act(view))
+    d, t, power, k, lead = p.decode(p.act(view))
     assert d in SPACE.distances and power in (-1.0, 1.0, 2.0, 3.0) and 0 <= k < SPACE.enemy_slots
+    assert lead in SPACE.leads
     text = p.to_text()
-    assert text.startswith("confront-tank 1\n") and "matrix w2 18 24" in text and "lead linear" in text
+    assert text.startswith("confront-tank 1\n") and f"matrix w2 {sum(SPACE.dims)} 24" in text
+    assert f"leads {' '.join(SPACE.leads)}" in text
     with pytest.raises(ValueError, match="chain"):
         TankPolicy((np.zeros((4, 5)),), (np.zeros(4),))
     with pytest.raises(ValueError, match="logits"):
@@ -241,10 +291,8 @@ def _write_run(run: Path, policy: TankPolicy) -> None:
     np.savez(model / "actor.npz", **{f"{n}{i}": a for i, (w, b) in enumerate(zip(policy.weights, policy.biases,
                                                                                   strict=True))
                                      for n, a in (("w", w), ("b", b))})
-    s = policy.space
     (model / "tank.json").write_text(json.dumps({
-        "distances": list(s.distances), "turns_deg": list(s.turns_deg), "fire_powers": list(s.fire_powers),
-        "enemy_slots": s.enemy_slots, "mate_slots": s.mate_slots, "lead": s.lead, "step_turns": policy.step_turns,
+        **asdict(policy.space), "step_turns": policy.step_turns,
         "control": {"radar_overshoot": policy.control.radar_overshoot, "aim_tolerance": 0.04}}))
 
 
@@ -286,3 +334,47 @@ def test_exported_tank_robot_plays(install, tmp_path) -> None:
     assert not [r for r in reports if "tank-error" in r or "tank-load-failed" in r or "Exception" in r], reports
     rounds = [r for r in reports if "tank-round" in r]
     assert rounds and int(rounds[0].split("decisions=")[1].split()[0]) > 10, reports
+
+
+@pytest.mark.engine
+@pytest.mark.parametrize("opponent", ["SpinBot"])
+def test_exported_robot_plays_like_the_simulator_turn_by_turn(install, tmp_path, opponent) -> None:
+    """The exported robot in the engine and the simulator driven by the Python twin, from the same start
+    positions: every robot's position, headings and energy agree at every turn while both live, up to the
+    first bullet-bullet hit (where the engine's random bullet order can decide; docs/engine.md)."""
+    from confront.arena.scenarios import get_scenario
+    from confront.engine.battle import BattleSpec
+    from confront.engine.runner import EngineOptions, run_battle
+
+    policy = _policy(6)
+    starts = ((150.0, 120.0, 30.0), (550.0, 420.0, 200.0))
+    jar = export_tank_robot(policy, tmp_path / "tankbot.jar", install)
+    trace = tmp_path / "trace.jsonl"
+    run = run_battle(BattleSpec(("confront.TankBot 1.0", opponent), rounds=1, max_turns=400, initial_positions=starts),
+                     EngineOptions(seed=1, cpu_constant_ms=50.0), trace=trace, extra_robots=[jar])
+    assert not run.errors and not sum(run.skipped_turns.values())
+    keys = ("x", "y", "body_heading", "gun_heading", "radar_heading", "energy")
+    turns = [json.loads(line) for line in trace.read_text().splitlines()]
+    turns = [t for t in turns if t.get("type") == "turn"]
+    eng = np.array([[[r[k] for k in keys] for r in t["robots"]] for t in turns])
+    clash = [i for i, t in enumerate(turns) if any(b["state"] == "HIT_BULLET" for b in t["bullets"])]
+
+    env = TeamBattleEnv(get_scenario("1v1").replace(initial_positions=starts, max_turns=100000), 1, seed=1,
+                        opponents=opponent, config=SMDPConfig(turns_per_step=policy.step_turns, tank=policy.space,
+                                                               reward="score", auto_reset=False))
+    _, feats = env.reset()
+    env.start_recording(0)
+    while env.arena.state.time[0] < len(eng) and not env.arena.state.done[0]:
+        feats = env.step(np.array([[policy.act(feats[0, 0]), 0]])).features
+    replay = env.stop_recording()
+    sim = np.array([r for r, t in zip(replay.robots, replay.turn, strict=True) if t >= 1])[:, :, :6]  # turns 1, 2, ...
+    sim[:, :, 2:5] = np.radians(sim[:, :, 2:5])
+    n = min(len(sim), len(eng))
+    alive = (eng[:n, :, 5] > 0).all(axis=1)
+    n = int(np.argmin(alive)) + 1 if not alive.all() else n  # up to the turn a robot dies
+    n = min([n] + clash)
+    assert n > 200
+    d = np.abs(eng[:n] - sim[:n])
+    d[..., 2:5] = np.abs((eng[:n, :, 2:5] - sim[:n, :, 2:5] + math.pi) % (2 * math.pi) - math.pi)
+    bad = np.flatnonzero(d.max(axis=(1, 2)) > 1e-6)
+    assert bad.size == 0, f"turn {bad[0] + 1}: engine {eng[bad[0]]}, simulator {sim[bad[0]]}"

@@ -21,16 +21,17 @@ import robocode.TeamRobot;
  * A tank policy trained with confront (PPO over the tank view and tank actions), running with no Python.
  * Its policy is compiled into confront.TankData at export. Every step_turns turns it builds the tank view
  * (confront.arena.tank) from what it knows: its own getters, the last ScannedRobotEvent of each living enemy
- * this round (position, energy, heading, velocity, the energy drop since the previous scan, the scan time)
- * and the latest (x, y, energy) each living team-mate broadcast; it picks the greedy tank action (move,
- * body turn, fire power or hold, target slot). Every turn the gun/radar controller aims at the chosen
- * target (the nearest known enemy when that one is unknown or dead), leading it linearly.
+ * this round (position, energy, heading, velocity, the energy drop and turn rate since the previous scan, the
+ * scan time) and the latest (x, y, energy) each living team-mate broadcast; it picks the greedy tank action
+ * (move, body turn by an angle or to an angle from the target's bearing, fire power or hold, target slot, gun
+ * lead). Every turn the gun/radar controller aims at the chosen target (the nearest known enemy when that one
+ * is unknown or dead), with the step's lead (none, linear or circular).
  *
  * <p>Robocode makes a new robot object each round, so the memory starts empty every round. A team-mate's
  * broadcast arrives one turn later, so mates are seen as they were a turn ago (and not at all at turn 0).
  */
 public class TankBot extends TeamRobot {
-    /** name: {x, y, energy, heading, velocity, energy drop, scan time} of the last scan this round. */
+    /** name: {x, y, energy, heading, velocity, energy drop, scan time, turn rate} of the last scan this round. */
     private final Map<String, double[]> enemies = new LinkedHashMap<>();
     /** name: {x, y, energy} of the latest message this round. */
     private final Map<String, double[]> mates = new LinkedHashMap<>();
@@ -61,22 +62,26 @@ public class TankBot extends TeamRobot {
         int[] slots = new int[model.enemySlots];
         String chosen = null;
         double power = -1.0;
+        int lead = TankModel.LEAD_NONE;
+        long next = 0;  // the next decision turn: 0, step, 2 step, ... (a skipped decision turn is made up at once)
         while (true) {
             try {
                 broadcast();
                 String[] names = enemies.keySet().toArray(new String[0]);
                 double[][] known = enemies.values().toArray(new double[0][]);
                 double time = getTime();
-                if (getTime() % step == 0) {  // as PolicyBot: the commands set now take effect in turn getTime()+1
+                boolean decide = getTime() >= next;  // PolicyBot's phase: commands set now act in turn getTime()+1
+                double[] a = null;
+                if (decide) {
+                    next = (getTime() / step + 1) * step;
                     int matesAlive = Math.max(matesStart - deadMates.size(), 0);
                     double[] v = model.view(getX(), getY(), getHeadingRadians(), getVelocity(), getEnergy(),
                             getGunHeat(), Math.max(getOthers() - matesAlive, 0), enemiesStart, matesAlive,
                             matesStart, known, mates.values().toArray(new double[0][]), time,
                             getBattleFieldWidth(), getBattleFieldHeight(), slots);
-                    double[] a = model.decode(model.act(v));
-                    setAhead(a[0]);
-                    setTurnRightRadians(a[1]);
+                    a = model.decode(model.act(v));
                     power = a[2];
+                    lead = (int) a[4];
                     int k = (int) a[3];
                     chosen = slots[k] >= 0 ? names[slots[k]] : null;
                     decisions++;
@@ -88,8 +93,12 @@ public class TankBot extends TeamRobot {
                     }
                 }
                 int tgt = TankModel.target(getX(), getY(), known, c);
+                if (decide) {
+                    setAhead(a[0]);
+                    setTurnRightRadians(model.bodyTurn(getX(), getY(), getHeadingRadians(), known, tgt, a[1]));
+                }
                 double[] g = model.control(getX(), getY(), getGunHeadingRadians(), getRadarHeadingRadians(),
-                        getGunHeat(), getEnergy(), known, tgt, power, time, getBattleFieldWidth(),
+                        getGunHeat(), getEnergy(), known, tgt, power, lead, time, getBattleFieldWidth(),
                         getBattleFieldHeight());
                 if (!Double.isNaN(g[0])) {
                     setTurnGunRightRadians(g[0]);
@@ -136,6 +145,14 @@ public class TankBot extends TeamRobot {
 
     @Override
     public void onScannedRobot(ScannedRobotEvent e) {
+        try {
+            remember(e);
+        } catch (RuntimeException x) {
+            out.println("CONFRONT tank-error scan " + x);
+        }
+    }
+
+    private void remember(ScannedRobotEvent e) {
         String name = e.getName();
         if (isTeammate(name)) {
             return;
@@ -143,9 +160,10 @@ public class TankBot extends TeamRobot {
         double abs = getHeadingRadians() + e.getBearingRadians();
         double[] prev = enemies.get(name);
         double drop = prev != null ? prev[2] - e.getEnergy() : 0.0;
+        double rate = TankModel.turnRate(prev, e.getHeadingRadians(), e.getTime());
         enemies.put(name, new double[] {getX() + e.getDistance() * Math.sin(abs),
                 getY() + e.getDistance() * Math.cos(abs), e.getEnergy(), e.getHeadingRadians(), e.getVelocity(),
-                drop, e.getTime()});
+                drop, e.getTime(), rate});
     }
 
     @Override

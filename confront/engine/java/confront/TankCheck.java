@@ -12,8 +12,9 @@ import java.io.InputStreamReader;
  * <li>"V own enemies mates", own = x y heading velocity energy gunHeat enemiesAlive enemiesStart matesAlive
  * matesStart time width height; prints the view, then "|" and the slots.</li>
  * <li>"A view"; prints the joint action, then "|" and the logits.</li>
- * <li>"C own enemies", own = x y gunHeading radarHeading gunHeat energy power chosen time width height;
- * prints gun radar fire target.</li>
+ * <li>"C own enemies", own = x y heading gunHeading radarHeading gunHeat energy power chosen turn lead time
+ * width height (lead: 0 none, 1 linear, 2 circular); prints gun radar fire target bodyTurn.</li>
+ * <li>"R seen prevHeading prevTime heading time" (seen 0: no previous scan); prints the turn rate.</li>
  * </ul>
  */
 public final class TankCheck {
@@ -78,9 +79,17 @@ public final class TankCheck {
                 case "C": {
                     double[] o = nums(parts[1]);
                     double[][] en = rows(parts[2]);
-                    int tgt = TankModel.target(o[0], o[1], en, (int) o[7]);
-                    double[] g = m.control(o[0], o[1], o[2], o[3], o[4], o[5], en, tgt, o[6], o[8], o[9], o[10]);
-                    out.append(g[0]).append(' ').append(g[1]).append(' ').append(g[2]).append(' ').append(tgt);
+                    int tgt = TankModel.target(o[0], o[1], en, (int) o[8]);
+                    double[] g = m.control(o[0], o[1], o[3], o[4], o[5], o[6], en, tgt, o[7], (int) o[10], o[11],
+                            o[12], o[13]);
+                    out.append(g[0]).append(' ').append(g[1]).append(' ').append(g[2]).append(' ').append(tgt)
+                            .append(' ').append(m.bodyTurn(o[0], o[1], o[2], en, tgt, o[9]));
+                    break;
+                }
+                case "R": {
+                    double[] o = nums(parts[1]);
+                    double[] prev = o[0] != 0 ? new double[] {0, 0, 0, o[1], 0, 0, o[2], 0} : null;
+                    out.append(TankModel.turnRate(prev, o[3], o[4]));
                     break;
                 }
                 default:

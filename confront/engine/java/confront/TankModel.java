@@ -10,12 +10,14 @@ import java.util.Map;
 
 /**
  * An exported tank policy (no Robocode dependency): the tank view of confront.arena.tank.tank_view_row, the
- * actor MLP (tanh hidden layers, linear logits), the greedy tank action (argmax per head) and the gun/radar
- * controller of confront.arena.smdp.controller_turn with the linear lead of confront.arena.tank.lead_point.
+ * actor MLP (tanh hidden layers, linear logits), the greedy tank action (argmax per head: distance, body turn,
+ * fire power, enemy slot, gun lead) and the gun/radar controller of confront.arena.smdp.controller_turn with
+ * the lead of confront.arena.tank.lead_point (none, linear or circular).
  * Mirrors confront.engine.tank_export.TankPolicy; the file format is written by its to_text().
  *
  * <p>Angles follow Robocode: radians, 0 = north (+y), clockwise. Enemy rows are {x, y, energy, heading,
- * velocity, energy drop, scan time} of the last scan this round; mate rows are {x, y, energy}.
+ * velocity, energy drop, scan time, turn rate} of the last scan this round (turnRate: see turnRate()); mate rows
+ * are {x, y, energy}.
  */
 public final class TankModel {
     static final double TWO_PI = 2 * Math.PI;
@@ -24,6 +26,10 @@ public final class TankModel {
     static final int MATE = 5;
     static final double MAX_AGE = 50.0;
     static final double WALL_MARGIN = 18.0;
+    static final double MAX_RATE = Math.PI / 18.0;  // Rules.MAX_TURN_RATE, 10 deg/turn
+    static final int LEAD_NONE = 0;
+    static final int LEAD_LINEAR = 1;
+    static final int LEAD_CIRCULAR = 2;
 
     final Map<String, String> keys = new HashMap<>();
     final List<double[][]> weights = new ArrayList<>();
@@ -34,7 +40,8 @@ public final class TankModel {
     int enemySlots;
     int mateSlots;
     int stepTurns;
-    boolean lead;
+    int[] leads;  // the lead head's choices: LEAD_NONE, LEAD_LINEAR, LEAD_CIRCULAR
+    boolean turnToTarget;  // turn_mode target: the body turn is an angle to the target's bearing
     double overshoot;
     double tolerance;
     double powerNear;
@@ -95,7 +102,24 @@ public final class TankModel {
         m.enemySlots = (int) m.num("enemy_slots");
         m.mateSlots = (int) m.num("mate_slots");
         m.stepTurns = (int) m.num("step_turns");
-        m.lead = "linear".equals(m.keys.get("lead"));
+        String mode = m.keys.get("turn_mode");
+        if (!"target".equals(mode) && !"body".equals(mode)) {
+            throw new IOException("turn_mode must be target or body, got " + mode);
+        }
+        m.turnToTarget = "target".equals(mode);
+        String[] leads = m.keys.getOrDefault("leads", "").trim().split(" ");
+        m.leads = new int[leads.length];
+        for (int i = 0; i < leads.length; i++) {
+            if ("none".equals(leads[i])) {
+                m.leads[i] = LEAD_NONE;
+            } else if ("linear".equals(leads[i])) {
+                m.leads[i] = LEAD_LINEAR;
+            } else if ("circular".equals(leads[i])) {
+                m.leads[i] = LEAD_CIRCULAR;
+            } else {
+                throw new IOException("leads must be none, linear or circular, got " + leads[i]);
+            }
+        }
         m.overshoot = m.num("radar_overshoot");
         m.tolerance = m.num("aim_tolerance");
         m.powerNear = m.num("power_near");
@@ -121,9 +145,12 @@ public final class TankModel {
             }
             in = w.length;
         }
-        int[] d = dims();
-        if (in != d[0] + d[1] + d[2] + d[3]) {
-            throw new IOException("the actor outputs " + in + " logits, the heads need " + (d[0] + d[1] + d[2] + d[3]));
+        int heads = 0;
+        for (int n : dims()) {
+            heads += n;
+        }
+        if (in != heads) {
+            throw new IOException("the actor outputs " + in + " logits, the heads need " + heads);
         }
     }
 
@@ -157,14 +184,15 @@ public final class TankModel {
         return OWN + ENEMY * enemySlots + MATE * mateSlots;
     }
 
-    /** Sizes of the four heads: distance, turn, fire power, enemy slot. */
+    /** Sizes of the five heads: distance, turn, fire power, enemy slot, lead. */
     public int[] dims() {
-        return new int[] {distances.length, turns.length, powers.length, enemySlots};
+        return new int[] {distances.length, turns.length, powers.length, enemySlots, leads.length};
     }
 
     /**
      * The tank view (tank_view_row, in double precision). enemies: the enemies known (alive, scanned this
-     * round), rows {x, y, energy, heading, velocity, drop, scan time}; mates: living team-mates {x, y, energy}.
+     * round), rows {x, y, energy, heading, velocity, drop, scan time, turn rate}; mates: living team-mates
+     * {x, y, energy}.
      * Slots are filled nearest first, ties to the lower row; slots[k] gets the enemy row of slot k (-1 empty).
      */
     public double[] view(double x, double y, double heading, double velocity, double energy, double gunHeat,
@@ -274,13 +302,13 @@ public final class TankModel {
         return h;
     }
 
-    /** Greedy joint action ((d * nt + t) * nf + f) * K + k: the first maximum of each head's logits. */
+    /** Greedy joint action (((d * nt + t) * nf + f) * K + k) * nl + l: the first maximum of each head's logits. */
     public int act(double[] view) {
         double[] z = logits(view);
         int[] d = dims();
         int joint = 0;
         int off = 0;
-        for (int head = 0; head < 4; head++) {
+        for (int head = 0; head < d.length; head++) {
             int best = 0;
             for (int i = 1; i < d[head]; i++) {
                 if (z[off + i] > z[off + best]) {
@@ -293,35 +321,78 @@ public final class TankModel {
         return joint;
     }
 
-    /** (distance, body turn rad, fire power (-1 = hold), enemy slot) of a joint action (action_table). */
+    /**
+     * (distance, body turn rad, fire power (-1 = hold), enemy slot, lead (LEAD_*)) of a joint action
+     * (action_table; the body turn as given, see bodyTurn).
+     */
     public double[] decode(int action) {
         int[] d = dims();
-        int k = action % d[3];
-        int f = (action / d[3]) % d[2];
-        int t = (action / (d[3] * d[2])) % d[1];
-        int dist = action / (d[3] * d[2] * d[1]);
-        double p = powers[f];
-        return new double[] {distances[dist], turns[t], p > 0 ? p : -1.0, k};
+        int[] idx = new int[d.length];
+        int rest = action;
+        for (int head = d.length - 1; head >= 0; head--) {
+            idx[head] = rest % d[head];
+            rest /= d[head];
+        }
+        double p = powers[idx[2]];
+        return new double[] {distances[idx[0]], turns[idx[1]], p > 0 ? p : -1.0, idx[3], leads[idx[4]]};
     }
 
     /**
-     * Linear lead (lead_point): where an enemy scanned at (mx, my) heading mh at velocity mv age turns ago is
-     * when a bullet of the power reaches it; clipped to where a robot's centre can be; 10 iterations.
+     * The lead (lead_point): where an enemy scanned at (mx, my) heading mh at velocity mv age turns ago, turning
+     * rate rad/turn (0 = linear), is when a bullet of the power reaches it; clipped to where a robot's centre
+     * can be; 10 fixed-point iterations.
      */
-    public static double[] leadPoint(double x, double y, double mx, double my, double mh, double mv, double age,
-                                     double power, double width, double height) {
+    public static double[] leadPoint(double x, double y, double mx, double my, double mh, double mv, double rate,
+                                     double age, double power, double width, double height) {
         double speed = 20.0 - 3.0 * power;
-        double s = Math.sin(mh);
-        double c = Math.cos(mh);
         double px = mx;
         double py = my;
         double t = 0.0;
         for (int i = 0; i < 10; i++) {
-            px = Math.min(Math.max(mx + s * mv * (age + t), WALL_MARGIN), width - WALL_MARGIN);
-            py = Math.min(Math.max(my + c * mv * (age + t), WALL_MARGIN), height - WALL_MARGIN);
+            double tau = age + t;
+            double ox;
+            double oy;
+            if (Math.abs(rate) < 1e-9) {
+                ox = Math.sin(mh) * mv * tau;
+                oy = Math.cos(mh) * mv * tau;
+            } else {
+                ox = mv / rate * (Math.cos(mh) - Math.cos(mh + rate * tau));
+                oy = mv / rate * (Math.sin(mh + rate * tau) - Math.sin(mh));
+            }
+            px = Math.min(Math.max(mx + ox, WALL_MARGIN), width - WALL_MARGIN);
+            py = Math.min(Math.max(my + oy, WALL_MARGIN), height - WALL_MARGIN);
             t = Math.hypot(px - x, py - y) / speed;
         }
         return new double[] {px, py};
+    }
+
+    /**
+     * An enemy's turn rate at a new scan (observe.remember_scans): the heading change since the previous scan
+     * this round over the turns between them, within +-10 deg/turn; 0 without a previous scan.
+     */
+    public static double turnRate(double[] prev, double heading, double time) {
+        if (prev == null) {
+            return 0.0;
+        }
+        double dt = time - prev[6];
+        if (!(dt > 0)) {
+            return 0.0;
+        }
+        double dh = relAngle(heading - prev[3]);
+        return Math.min(Math.max(dh / dt, -MAX_RATE), MAX_RATE);
+    }
+
+    /**
+     * The body turn to command at the start of a step for the action's turn (rad, + clockwise): with turn_mode
+     * target and a target (enemies[tgt]), the turn that puts the body at that angle to the target's bearing
+     * from its last scanned position, wrapped to [-pi, pi); else the turn itself.
+     */
+    public double bodyTurn(double x, double y, double heading, double[][] enemies, int tgt, double turn) {
+        if (!turnToTarget || tgt < 0) {
+            return turn;
+        }
+        double bearing = Math.atan2(enemies[tgt][0] - x, enemies[tgt][1] - y);
+        return relAngle(bearing + turn - heading);
     }
 
     /** The row to aim at: chosen when it is a known enemy (>= 0), else the nearest known (first of equals), -1. */
@@ -355,20 +426,22 @@ public final class TankModel {
 
     /**
      * (gun turn, radar turn, fire power) of the controller (controller_turn) toward enemies[tgt] (tgt -1: none:
-     * NaN = keep the gun, a full radar turn, no fire), with the linear lead when the policy has one. power:
-     * the step's chosen power (-1 = hold, 0 = by distance band).
+     * NaN = keep the gun, a full radar turn, no fire), with the step's lead (LEAD_*; the turn rate only when
+     * circular). power: the step's chosen power (-1 = hold, 0 = by distance band).
      */
     public double[] control(double x, double y, double gunHeading, double radarHeading, double gunHeat,
-                            double energy, double[][] enemies, int tgt, double power, double time, double width,
-                            double height) {
+                            double energy, double[][] enemies, int tgt, double power, int lead, double time,
+                            double width, double height) {
         if (tgt < 0) {
             return new double[] {Double.NaN, TWO_PI, 0.0};
         }
         double[] e = enemies[tgt];
         double tx = e[0];
         double ty = e[1];
-        if (lead) {
-            double[] p = leadPoint(x, y, tx, ty, e[3], e[4], time - e[6], power > 0 ? power : 2.0, width, height);
+        if (lead != LEAD_NONE) {
+            double rate = lead == LEAD_CIRCULAR ? e[7] : 0.0;
+            double[] p = leadPoint(x, y, tx, ty, e[3], e[4], rate, time - e[6], power > 0 ? power : 2.0, width,
+                    height);
             tx = p[0];
             ty = p[1];
         }

@@ -65,7 +65,7 @@ from .observe import (
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
 from .state import SCORE_PARTS
-from .tank import LEADS, MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_kernel
+from .tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_kernel
 
 __all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
 
@@ -194,7 +194,7 @@ class TeamBattleEnv:
         b, r = self.n_battles, self.n_robots
         if opponent_actions not in ("same", "paper"):
             raise ValueError(f"opponent_actions must be 'same' or 'paper', got {opponent_actions!r}")
-        self._move = np.zeros((b, r, 3))  # distance, body turn, 1 = turn relative to the target's bearing
+        self._move = np.zeros((b, r, 4))  # distance, body turn, 1 = turn relative to the target, lead (LEADS)
         self._power = np.zeros((b, r))
         self._chosen = np.full((b, r), -1, dtype=np.int64)  # the step's chosen target robot (-1: by rule)
         tank = self.config.tank
@@ -210,7 +210,6 @@ class TeamBattleEnv:
         c = self.config.control
         self._ctrl = np.array([c.radar_overshoot, c.aim_tolerance, c.power_near, c.power_mid, c.power_far,
                                c.near_distance, c.far_distance, float(c.fire),
-                               float(LEADS[tank.lead]) if tank is not None else 0.0,
                                float(REWARDS[self.config.reward])])
         p, a = self.arena.state.packed, self.arena
         threads = numba.get_num_threads()
@@ -463,23 +462,23 @@ def _purge_stale_cache() -> None:
 
 
 _purge_stale_cache()
-C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_LEAD, C_REWARD = range(10)
+C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = range(9)
 
 
 def _action_tables(cfg: SMDPConfig, learner: np.ndarray, team: np.ndarray, opponent_actions: str
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Action tables (2, A, 5) of (distance, body turn, fire power, target slot, relative turn) rows, 0 = the
+    """Action tables (2, A, 6) of (distance, body turn, fire power, target slot, relative turn, lead) rows, 0 = the
     learners',
     1 = the caller-driven opponents'; each robot's table (R,) (-1: scripted); actions per table (2,).
     Fire power 0 = by distance (the paper's controller), -1 = hold fire; slot -1 = the target rule's."""
     dist, turn = move_commands(np.arange(N_MOVES), cfg.control)
     a = np.arange(cfg.paper_actions)
     powers = np.asarray(cfg.fire_powers)[a // N_MOVES] if cfg.fire_power_actions else np.zeros(a.size)
-    paper = np.stack([dist[a % N_MOVES], turn[a % N_MOVES], powers, np.full(a.size, -1.0), np.zeros(a.size)],
-                     axis=1)
+    paper = np.stack([dist[a % N_MOVES], turn[a % N_MOVES], powers, np.full(a.size, -1.0), np.zeros(a.size),
+                      np.zeros(a.size)], axis=1)
     ours = action_table(cfg.tank) if cfg.tank is not None else paper
     theirs = paper if opponent_actions == "paper" else ours
-    tables = np.zeros((2, max(len(ours), len(theirs)), 5))
+    tables = np.zeros((2, max(len(ours), len(theirs)), 6))
     tables[0, :len(ours)], tables[1, :len(theirs)] = ours, theirs
     space = np.where(learner, np.where(team == 0, 0, 1), -1).astype(np.int64)
     return tables, space, np.array([len(ours), len(theirs)], dtype=np.int64)
@@ -505,6 +504,7 @@ def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndar
             move[b, i, 0] = row[0]
             move[b, i, 1] = row[1]
             move[b, i, 2] = row[4]
+            move[b, i, 3] = row[5]
             power[b, i] = row[2]
             k = int(row[3])
             chosen[b, i] = slots[b, i, k] if sp >= 0 and 0 <= k < slots.shape[2] else -1
@@ -572,7 +572,7 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 rewards, max_distance, target, disc, feats, view, k_slots, m_slots, slots):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
-    when ``ctrl[C_LEAD]``), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of the team's
+    per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of the team's
     score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
     disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0). Returns the turn index
     where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
@@ -612,9 +612,9 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     cmd[b, i, 4] = 0.0
                     if rb[b, K.ALIVE, i]:
                         tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
-                        if tg >= 0 and ctrl[C_LEAD] > 0 and sensing == 1:
+                        if tg >= 0 and move[b, i, 3] > 0 and sensing == 1:
                             aim_power = power[b, i] if power[b, i] > 0 else 2.0
-                            rate = memory[b, 7, i, tg] if ctrl[C_LEAD] > 1 else 0.0
+                            rate = memory[b, 7, i, tg] if move[b, i, 3] > 1 else 0.0
                             tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, 3, i, tg],
                                                 memory[b, 4, i, tg], rate, float(bi[b, K.TIME] - scan_time[b, i, tg]),
                                                 aim_power, width, height)

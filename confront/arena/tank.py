@@ -32,13 +32,14 @@ everything a real robot can know (its own getters, its radar's ScannedRobotEvent
 Nothing names an opponent. The slot map ``slots`` (B, R, K) keeps which robot fills each enemy slot, so the
 action's target slot can be resolved to a robot.
 
-Tank actions: four heads, one joint integer ``((d * n_turns + t) * n_fire + f) * K + k``: a move distance
+Tank actions: five heads, one joint integer ``(((d * n_turns + t) * n_fire + f) * K + k) * n_leads + l``
+(``np.ravel_multi_index`` over ``TankSpace.dims``): a move distance
 (px, + ahead) and a body turn set once at the start of the T-turn step (``turn_mode="target"``: the turn
 that puts the body at that angle (rad, + clockwise) to the target's bearing, so 0 faces it and +-90 deg
 circles it; ``"body"`` or no known target: a turn by that angle), a fire power
-(0 = hold fire), and the enemy slot to target. The fixed gun/radar controller (paper §6.1) then aims at
-that target every turn, optionally leading it linearly (``lead_point``), and fires with the chosen power
-when the gun is on target and cold.
+(0 = hold fire), the enemy slot to target, and the gun's lead (none: at the last scanned position; linear;
+circular: with the turn rate between scans). The fixed gun/radar controller (paper §6.1) then aims at that
+target every turn (``lead_point``) and fires with the chosen power when the gun is on target and cold.
 
 Scan memory rows (``memory`` (B, MEMORY_ROWS, R, R), ``[b, :, i, j]`` = robot j at robot i's last scan of
 it): x, y, energy, heading, velocity, energy drop since the previous scan, 1 when scanned this round, its
@@ -98,7 +99,7 @@ class TankSpace:
     fire_powers: tuple[float, ...] = (0.0, 1.0, 2.0, 3.0)  # 0 = hold fire
     enemy_slots: int = 4  # K
     mate_slots: int = 3  # M
-    lead: Literal["none", "linear", "circular"] = "circular"
+    leads: tuple[str, ...] = ("none", "circular")  # the lead head's choices, of LEADS
 
     def __post_init__(self) -> None:
         for name in ("distances", "turns_deg", "fire_powers"):
@@ -115,13 +116,13 @@ class TankSpace:
             raise ValueError(f"tank.mate_slots must be an integer in 0..16, got {self.mate_slots!r}")
         if self.turn_mode not in ("target", "body"):
             raise ValueError(f"tank.turn_mode must be 'target' or 'body', got {self.turn_mode!r}")
-        if self.lead not in LEADS:
-            raise ValueError(f"tank.lead must be one of {', '.join(LEADS)}, got {self.lead!r}")
+        if not self.leads or any(v not in LEADS for v in self.leads):
+            raise ValueError(f"tank.leads must be a non-empty list of {', '.join(LEADS)}, got {self.leads!r}")
 
     @property
-    def dims(self) -> tuple[int, int, int, int]:
-        """Sizes of the four action heads: distance, turn, fire, target slot."""
-        return len(self.distances), len(self.turns_deg), len(self.fire_powers), self.enemy_slots
+    def dims(self) -> tuple[int, int, int, int, int]:
+        """Sizes of the five action heads: distance, turn, fire, target slot, lead."""
+        return len(self.distances), len(self.turns_deg), len(self.fire_powers), self.enemy_slots, len(self.leads)
 
     @property
     def n_actions(self) -> int:
@@ -135,17 +136,15 @@ class TankSpace:
 
 
 def action_table(space: TankSpace) -> np.ndarray:
-    """(n_actions, 5) rows of (distance, body turn, fire power (-1 = hold), target slot, 1 when the turn is
-    relative to the target's bearing) per joint action."""
-    nd, nt, nf, nk = space.dims
-    a = np.arange(space.n_actions)
-    k, f = a % nk, (a // nk) % nf
-    t, d = (a // (nk * nf)) % nt, a // (nk * nf * nt)
+    """(n_actions, 6) rows of (distance, body turn, fire power (-1 = hold), target slot, 1 when the turn is
+    relative to the target's bearing, the gun's lead (LEADS)) per joint action."""
+    d, t, f, k, lead = np.unravel_index(np.arange(space.n_actions), space.dims)
     power = np.asarray(space.fire_powers, dtype=np.float64)[f]
     return np.stack([np.asarray(space.distances, dtype=np.float64)[d],
                      np.radians(np.asarray(space.turns_deg, dtype=np.float64))[t],
                      np.where(power > 0, power, -1.0), k.astype(np.float64),
-                     np.full(a.size, 1.0 if space.turn_mode == "target" else 0.0)], axis=1)
+                     np.full(d.size, 1.0 if space.turn_mode == "target" else 0.0),
+                     np.array([float(LEADS[v]) for v in space.leads])[lead]], axis=1)
 
 
 @njit(cache=True)

@@ -74,12 +74,13 @@ def cli() -> None:
 @click.option("--out", type=click.Path(path_type=Path), default=None, help="Run folder (default runs/demo-<time>).")
 @click.option("--rounds", type=COUNT, default=None, help="Rounds to train (default from the demo config).")
 @click.option("--seed", type=SEED, default=None)
+@click.option("--paper", is_flag=True, help="Train the paper's 4v4 fuzzy DMNN arm instead (config demo).")
 @set_option
-def demo(out: Path | None, rounds: int | None, seed: int | None, overrides: tuple[str, ...]) -> None:
-    """Train a small 4v4 fuzzy DMNN team against the TD team, then print and plot the results."""
+def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, overrides: tuple[str, ...]) -> None:
+    """Train PPO tanks against the TD team, a dodging team and sample robots, then print and plot the results."""
     from confront.experiments.demo import run_demo
 
-    run_demo(out=out, rounds=rounds, seed=seed, overrides=overrides)
+    run_demo(out=out, rounds=rounds, seed=seed, overrides=overrides, paper=paper)
 
 
 @cli.command()

@@ -6,7 +6,9 @@
 
 Opponents (``league.opponents``, ``SCENARIO:OPPONENT``): a scripted sample robot (in 4v4 a team of four),
 ``td`` (the paper's TD team, greedy, paper moves), ``random`` (uniform paper moves), ``dodge`` (a hand-written
-stochastic dodge on the tank view), ``self`` (a snapshot of the policy, sampled from the last few).
+stochastic dodge over the paper's state and moves), ``strafe`` (a hand-written strafer with the learners' own
+actions and gun), ``self`` (a snapshot of the policy, sampled from the last few). Opponents in the paper's
+moves play the paper's controller (no lead, power by distance).
 Nothing in a tank's view names its opponent.
 
 Run folder: ``metrics/rounds.csv`` (one row per round: opponent, scores, share), ``metrics/sessions.csv``,
@@ -28,7 +30,7 @@ import click
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.arena.observe import ObservationConfig
+from confront.arena.observe import N_DIST_BINS, N_HEADING_BINS, ObservationConfig
 from confront.arena.pool import PoolEntry, PoolEnv, PoolStep
 from confront.arena.smdp import SMDPConfig
 from confront.arena.tank import OWN_FEATURES, TankSpace
@@ -36,7 +38,8 @@ from confront.experiments.spec import ExperimentConfig
 from confront.learning.ppo import PPO, PPOConfig, Rollout
 from confront.runs import Run
 
-__all__ = ["train_tanks", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "SnapshotPolicy",
+__all__ = ["train_tanks", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
+           "SnapshotPolicy",
            "save_tank_model", "load_tank_model", "evaluate_tanks"]
 
 
@@ -45,7 +48,7 @@ def tank_space(cfg: ExperimentConfig) -> TankSpace:
     t = cfg.tank
     return TankSpace(distances=tuple(t.distances), turns_deg=tuple(t.turns_deg), turn_mode=t.turn_mode,
                      fire_powers=tuple(t.fire_powers), enemy_slots=t.enemy_slots, mate_slots=t.mate_slots,
-                     lead=t.lead)
+                     leads=tuple(t.leads))
 
 
 def smdp_tank_config(cfg: ExperimentConfig) -> SMDPConfig:
@@ -66,14 +69,24 @@ def random_policy(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator)
     return rng.integers(0, 4, size=len(disc))
 
 
-def dodge_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
-    """A hand-written stochastic dodge on the tank view: the body perpendicular to the nearest known enemy,
-    full distance ahead or back at random each step, fire power 2 at it (the tank actions)."""
+def dodge_policy(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """The hand-written stochastic dodge over the paper's own state and moves (§6.1): with the target ahead or
+    behind (rel bins 0, 2) turn 45 deg either way at random, with it at a side (bins 1, 3) drive forward or
+    backward at random; the paper's gun controller (no lead)."""
+    rel = disc // (N_HEADING_BINS * N_DIST_BINS)
+    side = (rel == 1) | (rel == 3)
+    return np.where(side, rng.integers(0, 2, len(disc)), 2 + rng.integers(0, 2, len(disc)))
+
+
+def strafe_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
+    """A hand-written stochastic strafer in the tank actions, with the learners' own gun: the body perpendicular
+    to the nearest known enemy, full distance on in the direction it moves (reversed with probability 0.2 each
+    step), fire power 1 with the last lead of ``space.leads``."""
     turns = np.radians(np.asarray(space.turns_deg))
     dists = np.asarray(space.distances)
     powers = np.asarray(space.fire_powers)
     far = int(np.argmax(dists)), int(np.argmin(dists))
-    fire = int(np.argmin(np.abs(powers - 2.0)))
+    fire = int(np.argmin(np.abs(powers - 1.0)))
     side = int(np.argmin(np.abs(np.abs(turns) - np.pi / 2)))  # the angle nearest 90 deg (turn_mode "target")
 
     def act(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -85,9 +98,11 @@ def dodge_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
             cand = (np.stack([rel + np.pi / 2, rel - np.pi / 2]) + np.pi) % (2 * np.pi) - np.pi
             want = np.where(np.abs(cand[0]) < np.abs(cand[1]), cand[0], cand[1])  # the smaller perpendicular turn
             t = np.argmin(np.abs(turns[None, :] - want[:, None]), axis=1)
-        d = np.where(rng.random(len(disc)) < 0.5, far[0], far[1])
+        ahead = np.where(rng.random(len(disc)) < 0.8, feats[:, 6] >= 0, feats[:, 6] < 0)  # keep going, or reverse
+        d = np.where(ahead, far[0], far[1])
         f = np.where(feats[:, o] > 0, fire, int(np.argmin(powers)))
-        return np.ravel_multi_index((d, t, f, np.zeros_like(d)), space.dims)
+        zero = np.zeros_like(d)
+        return np.ravel_multi_index((d, t, f, zero, np.full_like(d, len(space.leads) - 1)), space.dims)
 
     return act
 
@@ -139,7 +154,9 @@ def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, pro
         elif opp == "random":
             entries.append(PoolEntry(e, scen, "td", n, policy=random_policy, opponent_actions="paper"))
         elif opp == "dodge":
-            entries.append(PoolEntry(e, scen, "td", n, policy=dodge_policy(space)))
+            entries.append(PoolEntry(e, scen, "td", n, policy=dodge_policy, opponent_actions="paper"))
+        elif opp == "strafe":
+            entries.append(PoolEntry(e, scen, "td", n, policy=strafe_policy(space)))
         elif opp == "self":
             entries.append(PoolEntry(e, scen, "td", n, policy=snap))
         else:

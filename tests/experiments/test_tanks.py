@@ -39,30 +39,38 @@ def test_lead_point_linear_and_circular() -> None:
     # a target 200 px north moving east at 8 px/turn, scanned now; power 3 bullets fly 11 px/turn
     px, py = lead_point(400.0, 100.0, 400.0, 300.0, math.pi / 2, 8.0, 0.0, 0.0, 3.0, 800.0, 600.0)
     t = math.hypot(px - 400, py - 100) / 11.0
-    assert py == pytest.approx(300.0) and px == pytest.approx(400 + 8 * t)
+    assert py == pytest.approx(300.0) and px == pytest.approx(400 + 8 * t, rel=1e-3)  # 10 fixed-point steps
     # turning: after tau turns on the circle of radius v / w
     w = math.radians(5)
     cx, cy = lead_point(400.0, 100.0, 400.0, 300.0, math.pi / 2, 8.0, w, 0.0, 3.0, 800.0, 600.0)
     tau = math.hypot(cx - 400, cy - 100) / 11.0
-    assert cx == pytest.approx(400 + 8 / w * (math.cos(math.pi / 2) - math.cos(math.pi / 2 + w * tau)))
-    assert cy == pytest.approx(300 + 8 / w * (math.sin(math.pi / 2 + w * tau) - 1.0)) and cy < 300
+    assert cx == pytest.approx(400 + 8 / w * (math.cos(math.pi / 2) - math.cos(math.pi / 2 + w * tau)), rel=1e-3)
+    assert cy == pytest.approx(300 + 8 / w * (math.sin(math.pi / 2 + w * tau) - 1.0), rel=1e-3) and cy < 300
 
 
 def test_action_table_decodes_the_heads() -> None:
     space = TankSpace()
     table = action_table(space)
-    a = np.ravel_multi_index((4, 0, 0, 2), space.dims)
-    np.testing.assert_allclose(table[a], [150.0, math.radians(-90.0), -1.0, 2.0, 1.0])  # hold fire: -1
+    a = np.ravel_multi_index((4, 0, 0, 2, 1), space.dims)
+    np.testing.assert_allclose(table[a], [150.0, math.radians(-90.0), -1.0, 2.0, 1.0, 2.0])  # hold: -1, circular: 2
+    assert table[a - 1, 5] == 0.0 and len(table) == 5 * 5 * 4 * 4 * 2
 
 
-def test_hold_fire_never_fires_and_chosen_target_is_aimed() -> None:
-    space = TankSpace(fire_powers=(0.0,), distances=(0.0,), turns_deg=(0.0,))
+def test_hold_fire_never_fires_and_the_slot_picks_the_target() -> None:
+    space = TankSpace(fire_powers=(0.0,), distances=(0.0,), turns_deg=(0.0,), leads=("none",))
     env = TeamBattleEnv("4v4", n_battles=2, seed=1, opponents="SittingDuck",
                         config=SMDPConfig(turns_per_step=5, tank=space, reward="score"))
     env.reset()
-    for _ in range(20):
-        env.step(np.zeros((2, 8), dtype=np.int64))
-    assert (env.arena.state.energy[:, :4] == 100.0).all()  # nobody fired, nobody was hit
+    start = env.arena.state.energy.copy()  # the team leaders start with 200
+    slots_seen = 0
+    for step in range(20):
+        k = step % space.enemy_slots
+        before = env.slots.copy()
+        env.step(np.full((2, 8), k, dtype=np.int64))  # joint action = the slot (the other heads have one choice)
+        np.testing.assert_array_equal(env._chosen[:, :4], before[:, :4, k])
+        slots_seen += int((before[:, :4, k] >= 4).sum())
+    assert slots_seen > 0
+    np.testing.assert_array_equal(env.arena.state.energy, start)  # nobody fired, nobody was hit
 
 
 def _cfg(tmp_path, opponents: str, **kw: str) -> object:

@@ -137,7 +137,7 @@ class PPOSection:
     """PPO hyper-parameters (confront.learning.ppo)."""
 
     hidden: int = field(128, ge=1, le=4096)
-    lr: float = field(2.5e-3, gt=0.0, le=1.0, doc="Adam step (measured: 2.5e-3 learned the league ~2x faster than 1e-3)")
+    lr: float = field(2.5e-3, gt=0.0, le=1.0, doc="Adam step (measured: 2.5e-3 learned ~2x faster than 1e-3)")
     rollout_steps: int = field(32, ge=1, le=4096)
     epochs: int = field(4, ge=1, le=100)
     minibatches: int = field(4, ge=1, le=1024)

@@ -66,8 +66,8 @@ def test_round_rows_by_hand() -> None:
 ])
 def test_bad_config_is_refused_before_anything_runs(tmp_path: Path, override: str, error: type[Exception],
                                                     match: str) -> None:
-    cfg = load_experiment("demo", ["train.rounds=2", "train.session_rounds=1", override])
-    with pytest.raises(error, match=match):
+    with pytest.raises(error, match=match):  # a scenario file or robot that does not exist: already on load
+        cfg = load_experiment("demo", ["train.rounds=2", "train.session_rounds=1", override])
         train_in_engine(cfg, tmp_path / "run", progress=False)
     assert not (tmp_path / "run").exists()
 

@@ -104,6 +104,17 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     real engine."""
     if sim_seeds < 1:
         raise ValueError(f"sim_seeds must be >= 1, got {sim_seeds}")
+    from confront.engine.tank_export import is_tank_run
+
+    if is_tank_run(run):  # PPO tanks: per league entry (the engine: the exported TankBot)
+        from confront.experiments.tanks import evaluate_tank_cli
+
+        evaluate_tank_cli(run, opponents, rounds, seed)
+        if engine == "robocode":
+            from confront.experiments.tanks import evaluate_tank_engine_cli
+
+            evaluate_tank_engine_cli(run, opponents, rounds, seed)
+        return
     cfg = _run_config(run)
     learner, _ = load_model(run)
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}

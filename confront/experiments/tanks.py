@@ -479,3 +479,56 @@ def print_tank_summary(summary: dict[str, Any]) -> None:
     click.echo(f"all: {summary['final_score_ratio']:.3f} (first session {summary['first_session_ratio']:.3f}, "
                f"last {summary['last_session_ratio']:.3f})")
     click.echo(f"run folder: {summary['run']}  (plots/, metrics/, model/, tb/, summary.json)")
+
+
+def league_entries(opponents: str | None, cfg: ExperimentConfig) -> tuple[str, ...]:
+    """``--opponents`` as league entries: ``SCENARIO:OPPONENT`` kept, a bare name is ``1v1:NAME``."""
+    if not opponents:
+        return tuple(cfg.league.opponents)
+    names = [o.strip() for o in opponents.split(",") if o.strip()]
+    return tuple(n if ":" in n else f"1v1:{n}" for n in names)
+
+
+def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int) -> dict[str, dict[str, float]]:
+    """Greedy shares of a PPO run per league entry in the simulator, printed as a table."""
+    from dataclasses import replace
+
+    from confront.experiments.spec import config_from_dict, load_toml
+
+    cfg = config_from_dict(load_toml(run / "config.toml"))
+    entries = league_entries(opponents, cfg)
+    try:
+        cfg = replace(cfg, league=replace(cfg.league, opponents=entries))
+    except ValueError as exc:
+        raise click.UsageError(str(exc)) from None
+    ppo = load_tank_model(run, cfg)
+    res = evaluate_tanks(cfg, ppo, rounds, seed=seed)
+    click.echo(f"\n{run}: greedy policy, {rounds} rounds per opponent (simulator, seed {seed})\n")
+    click.echo("| opponent | rounds | score share | win rate |\n|---|---:|---:|---:|")
+    for name in entries:
+        r = res[name]
+        click.echo(f"| {name} | {r['rounds']} | {r['share']:.3f} | {r['win_rate']:.2f} |")
+    return res
+
+
+def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed: int,
+                             seeds: int = 1) -> dict[str, list[float]]:
+    """The exported TankBot (a jar, no Python) in the real engine against each scripted league entry, ``seeds``
+    battles of ``rounds`` rounds (engine seeds ``seed``, ``seed + 1``, ...): our score ratio per battle."""
+    from confront.arena.bots import BOT_NAMES
+    from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
+    from confront.experiments.spec import config_from_dict, load_toml
+
+    cfg = config_from_dict(load_toml(run / "config.toml"))
+    policy = load_tank_policy(run)
+    out: dict[str, list[float]] = {}
+    click.echo(f"\n{run}: the exported TankBot in Robocode, {rounds} rounds x {seeds} battle(s) per opponent\n")
+    click.echo("| opponent | battles | score ratio (robocode) |\n|---|---:|---:|")
+    for entry in league_entries(opponents, cfg):
+        scen, _, opp = entry.partition(":")
+        if opp not in BOT_NAMES:
+            click.echo(f"| {entry} | - | simulator only |")
+            continue
+        out[entry] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed + k)[1] for k in range(seeds)]
+        click.echo(f"| {entry} | {seeds} | {' / '.join(f'{v:.3f}' for v in out[entry])} |")
+    return out

@@ -36,11 +36,14 @@ from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point
 from confront.engine.export import policy_data_source
 from confront.engine.install import EngineInstall, find_engine
 from confront.engine.java_build import compile_java
+from confront.results import BattleResults
 
 __all__ = ["TankPolicy", "robot_view", "robot_target", "robot_control", "body_turn", "turn_rate",
-           "export_tank_robot", "is_tank_run", "load_tank_policy", "TANK_CLASSES"]
+           "export_tank_robot", "evaluate_tank_policy", "is_tank_run", "load_tank_policy", "TANK_CLASSES",
+           "TANK_ROBOT"]
 
 TANK_CLASSES = ("TankBot", "TankModel", "RoundStart")
+TANK_ROBOT = "confront.TankBot 1.0"  # the exported jar's robot name
 EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time, turn rate
 MAX_RATE = math.pi / 18.0  # Rules.MAX_TURN_RATE, 10 deg/turn
 MateRow = Sequence[float]  # x, y, energy
@@ -281,6 +284,23 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
             subprocess.run([jar, "cf", str(out.resolve()), "-C", str(root), "."], check=True,
                            capture_output=True)
     return out
+
+
+def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,
+                         seed: int = 0, cpu_constant_ms: float = 10.0,
+                         install: EngineInstall | None = None) -> tuple[BattleResults, float]:
+    """Play the exported TankBot (a jar, no Python in the loop) for our side of ``scenario`` (``1v1``,
+    ``4v4``, ...) against ``opponents`` in the engine; return (results, our score ratio)."""
+    from confront.engine.battle import scenario_battle
+    from confront.engine.runner import EngineOptions, run_battle
+
+    with tempfile.TemporaryDirectory(prefix="confront-tank-eval-") as tmp:
+        jar = export_tank_robot(policy, Path(tmp) / "tankbot.jar", install)
+        spec = scenario_battle(scenario, TANK_ROBOT, opponents, rounds=rounds)
+        res = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms), extra_robots=[jar],
+                         install=install).results
+    ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))
+    return res, res.score_ratio(ours.name)
 
 
 def _model_dir(run: str | Path) -> Path:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import subprocess
+import tempfile
 import zipfile
 from dataclasses import asdict
 from pathlib import Path
@@ -334,6 +335,24 @@ def test_exported_tank_robot_plays(install, tmp_path) -> None:
     assert not [r for r in reports if "tank-error" in r or "tank-load-failed" in r or "Exception" in r], reports
     rounds = [r for r in reports if "tank-round" in r]
     assert rounds and int(rounds[0].split("decisions=")[1].split()[0]) > 10, reports
+
+
+@pytest.mark.engine
+def test_exported_team_plays(install) -> None:
+    from confront.engine.battle import scenario_battle
+    from confront.engine.runner import EngineOptions, run_battle
+    from confront.engine.tank_export import TANK_ROBOT, evaluate_tank_policy
+
+    with tempfile.TemporaryDirectory() as tmp:
+        jar = export_tank_robot(_policy(7), Path(tmp) / "tankbot.jar", install)
+        run = run_battle(scenario_battle("4v4", TANK_ROBOT, "SpinBot", rounds=1), EngineOptions(seed=2),
+                         extra_robots=[jar])
+    reports = run.summary["robot_reports"]
+    assert not run.errors and run.results.rounds == 1
+    assert not [r for r in reports if "tank-error" in r or "tank-load-failed" in r], reports
+    res, ratio = evaluate_tank_policy(_policy(7), "1v1", "SittingDuck", rounds=1, seed=1, install=install)
+    ours = next(r for r in res.contestants if r.name.startswith("confront.TankBot"))
+    assert res.rounds == 1 and ratio == res.score_ratio(ours.name)
 
 
 @pytest.mark.engine

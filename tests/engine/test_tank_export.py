@@ -397,3 +397,25 @@ def test_exported_robot_plays_like_the_simulator_turn_by_turn(install, tmp_path,
     d[..., 2:5] = np.abs((eng[:n, :, 2:5] - sim[:n, :, 2:5] + math.pi) % (2 * math.pi) - math.pi)
     bad = np.flatnonzero(d.max(axis=(1, 2)) > 1e-6)
     assert bad.size == 0, f"turn {bad[0] + 1}: engine {eng[bad[0]]}, simulator {sim[bad[0]]}"
+
+
+def test_twin_acts_like_the_ppo_learner(views) -> None:
+    """The learner's actor arrays, as ``confront train`` saves them, give the learner's greedy actions."""
+    from confront.learning.ppo import PPO, PPOConfig
+
+    ppo = PPO(SPACE.n_features, SPACE.dims, PPOConfig(hidden=32), seed=3)
+    rng = np.random.default_rng(5)
+    ppo.load_actor_arrays({k: rng.normal(0, 0.5, v.shape) for k, v in ppo.actor_arrays().items()})
+    policy = TankPolicy.from_state(ppo.actor_arrays(), SPACE)
+    obs = np.stack([f for _, f, _ in views])
+    joint = ppo.act(obs, explore=False)[0]
+    close = 0
+    for v, a in zip(obs, joint, strict=True):
+        z, off, near = policy.logits(v), 0, False
+        for n in SPACE.dims:  # a float32 (torch) vs float64 near-tie may pick either
+            top = np.sort(z[off:off + n])[-2:]
+            near |= n > 1 and top[1] - top[0] < 1e-5
+            off += n
+        close += near
+        assert near or policy.act(v) == int(a)
+    assert close < len(obs) // 100 and len(set(joint.tolist())) > 10

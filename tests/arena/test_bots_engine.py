@@ -25,6 +25,7 @@ FIXES = {
     "sample_hit_robot_per_collision": "one HitRobotEvent per collision (two in a turn when both are at fault)",
     "sample_disabled_runs": "a disabled robot's code runs on (gun turns, events, energy regained)",
     "sample_interruptible_next_round": "the last wake of a dying robot; the interruptible flag outlives the round",
+    "sample_stopped_at_round_start": "each round starts stopped: the first stop() saves nothing (Corners)",
     "sample_degrees": "degree arithmetic as the robot API does it (a gun left at exactly 2 pi for a turn)",
     "sample_victory_dance": "the winner's onWin (Tracker's dance) in the turns after the end",
     "sample_trackfire": "sample.TrackFire (degrees, gun heat, its onWin spin)",

@@ -329,6 +329,8 @@ def load_tank_policy(run: str | Path) -> TankPolicy:
     step = cfg.get("step_turns", cfg.get("turns_per_step"))
     if step is None:
         raise ValueError(f"{folder / 'tank.json'} lacks step_turns")
+    if "dims" in cfg and tuple(cfg["dims"]) != space.dims:
+        raise ValueError(f"{folder / 'tank.json'}: dims {cfg['dims']} do not match the action heads {space.dims}")
     with np.load(folder / "actor.npz", allow_pickle=False) as z:
         state = {k: z[k] for k in z.files}
     return TankPolicy.from_state(state, space, control, int(step))

@@ -305,6 +305,10 @@ def test_run_folder_loads(tmp_path) -> None:
     q = load_tank_policy(tmp_path / "run")
     assert q.space == space and q.step_turns == 5 and q.control.aim_tolerance == 0.04
     assert q.to_text().split("aim_tolerance")[0] == p.to_text().split("aim_tolerance")[0]
+    tank = json.loads((tmp_path / "run" / "model" / "tank.json").read_text())
+    (tmp_path / "run" / "model" / "tank.json").write_text(json.dumps({**tank, "dims": [2, 5, 4, 2, 2]}))
+    with pytest.raises(ValueError, match="dims"):
+        load_tank_policy(tmp_path / "run")
 
 
 # -- the exported robot in the engine -------------------------------------------------------------------

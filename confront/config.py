@@ -48,6 +48,15 @@ def field(
     return dataclasses.field(default=default, metadata=meta)
 
 
+def _show(value: Any) -> str:
+    """``repr(value)`` for a message: at most 80 characters."""
+    try:
+        text = repr(value)
+    except ValueError:  # an integer beyond Python's digit limit
+        return f"<an integer of {value.bit_length()} bits>"
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def _allowed(meta: Mapping[str, Any]) -> str:
     if meta.get("choices"):
         return "one of " + ", ".join(repr(c) for c in meta["choices"])
@@ -65,7 +74,7 @@ def _check_bounds(key: str, value: Any, meta: Mapping[str, Any]) -> None:
         return
     choices = meta.get("choices")
     if choices and value not in choices:
-        raise ConfigError(f"{key} = {value!r} is not allowed: use {_allowed(meta)}")
+        raise ConfigError(f"{key} = {_show(value)} is not allowed: use {_allowed(meta)}")
     if isinstance(value, int | float) and not isinstance(value, bool):
         bad = (
             (meta.get("ge") is not None and not value >= meta["ge"])
@@ -75,9 +84,9 @@ def _check_bounds(key: str, value: Any, meta: Mapping[str, Any]) -> None:
             or (isinstance(value, float) and math.isnan(value))
         )
         if bad:
-            raise ConfigError(f"{key} = {value!r} is out of range: must be {_allowed(meta)}")
+            raise ConfigError(f"{key} = {_show(value)} is out of range: must be {_allowed(meta)}")
         if isinstance(value, int) and not -(2**63) <= value < 2**63:
-            raise ConfigError(f"{key} = {value!r} is out of range: must fit in 64 bits")
+            raise ConfigError(f"{key} = {_show(value)} is out of range: must fit in 64 bits")
 
 
 def _type_name(tp: Any) -> str:
@@ -100,21 +109,21 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
             except ConfigError as exc:
                 errors.append(str(exc))
         allowed = " or ".join(_type_name(a) for a in args)
-        raise ConfigError(f"{key} = {value!r} has the wrong type: expected {allowed}")
+        raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected {allowed}")
     if origin is typing.Literal:
         if isinstance(value, bool) and str(value).lower() in args:  # --set k=true parses as a bool
             return str(value).lower()
         if value not in args:
-            raise ConfigError(f"{key} = {value!r} is not allowed: use one of {', '.join(map(repr, args))}")
+            raise ConfigError(f"{key} = {_show(value)} is not allowed: use one of {', '.join(map(repr, args))}")
         return value
     if origin in (tuple, list, Sequence) or tp in (tuple, list):
         if isinstance(value, str) or not isinstance(value, Sequence):
-            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a list")
+            raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected a list")
         if args and origin is tuple and len(args) == 2 and args[1] is Ellipsis:
             items = [_coerce(f"{key}[{i}]", v, args[0]) for i, v in enumerate(value)]
         elif args and origin is tuple:
             if len(args) != len(value):
-                raise ConfigError(f"{key} = {value!r} must have {len(args)} items")
+                raise ConfigError(f"{key} = {_show(value)} must have {len(args)} items")
             items = [_coerce(f"{key}[{i}]", v, a) for i, (v, a) in enumerate(zip(value, args, strict=True))]
         elif args:
             items = [_coerce(f"{key}[{i}]", v, args[0]) for i, v in enumerate(value)]
@@ -123,31 +132,31 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
         return tuple(items) if origin is tuple or tp is tuple else items
     if dataclasses.is_dataclass(tp):
         if not isinstance(value, Mapping):
-            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a table of {_type_name(tp)} keys")
+            raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected a table of {_type_name(tp)} keys")
         return from_dict(tp, value, prefix=key)
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a number")
+            raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected a number")
         if isinstance(value, int) and abs(value) > 2**1000 or not math.isfinite(value):
-            raise ConfigError(f"{key} = {str(value)[:60]} is out of range: must be a finite number")
+            raise ConfigError(f"{key} = {_show(value)} is out of range: must be a finite number")
         return float(value)
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{key} = {value!r} has the wrong type: expected an integer")
+            raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected an integer")
         return value
     if tp is bool:
         if not isinstance(value, bool):
-            raise ConfigError(f"{key} = {value!r} has the wrong type: expected true or false")
+            raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected true or false")
         return value
     if tp is str:
         if not isinstance(value, str):
-            raise ConfigError(f"{key} = {value!r} has the wrong type: expected a string")
+            raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected a string")
         if len(value) > MAX_STRING or any(ord(c) < 32 and c != "\t" or c == "\x7f" for c in value):
-            raise ConfigError(f"{key} = {value[:60]!r} is not allowed: use at most {MAX_STRING} printable "
+            raise ConfigError(f"{key} = {_show(value)} is not allowed: use at most {MAX_STRING} printable "
                               "characters on one line")
         return value
     if isinstance(tp, type) and not isinstance(value, tp):
-        raise ConfigError(f"{key} = {value!r} has the wrong type: expected {_type_name(tp)}")
+        raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected {_type_name(tp)}")
     return value
 
 
@@ -207,6 +216,8 @@ def parse_override(text: str) -> dict[str, Any]:
         value = tomllib.loads(f"v = {raw}")["v"]
     except (tomllib.TOMLDecodeError, RecursionError):
         value = raw
+    except ValueError:  # e.g. an integer of more than 4300 digits
+        raise ConfigError(f"--set {key} = {_show(raw)} cannot be read: numbers have at most 4300 digits") from None
     out: dict[str, Any] = {}
     node = out
     parts = key.split(".")
@@ -230,6 +241,8 @@ def load_toml(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"config file {str(p)!r} is not valid TOML: {str(exc).splitlines()[0]}") from None
     except UnicodeDecodeError:
         raise ConfigError(f"config file {str(p)!r} is not valid TOML: it is not UTF-8 text") from None
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        raise ConfigError(f"config file {str(p)!r} cannot be read: {str(exc).splitlines()[0][:120]}") from None
     except RecursionError:
         raise ConfigError(f"config file {str(p)!r} is nested too deeply") from None
     except OSError as exc:

@@ -63,8 +63,13 @@ def test_config_from_any_data(changes: list[tuple[tuple[str, str | None], Any]])
     assert from_dict(ExperimentConfig, tomllib.loads(text)) == cfg
 
 
+long_numbers = st.builds(lambda key, digits, sign: f"{key}={sign}{'7' * digits}",
+                         st.sampled_from(["learner.alpha", "train.seed", "x", "arena.battles"]),
+                         st.integers(1, 6000), st.sampled_from(["", "-", "+", "0x", "1e"]))
+
+
 @FUZZ
-@given(st.text(max_size=60))
+@given(st.text(max_size=60) | long_numbers)
 def test_config_override_text(text: str) -> None:
     try:
         load_experiment("demo", [text])
@@ -73,7 +78,8 @@ def test_config_override_text(text: str) -> None:
 
 
 @FUZZ
-@given(st.binary(max_size=300) | st.text(max_size=300).map(str.encode))
+@given(st.binary(max_size=300) | st.text(max_size=300).map(str.encode)
+       | long_numbers.map(lambda t: ("[learner]\n" + t.split(".")[-1].replace("=", " = ") + "\n").encode()))
 def test_config_file_bytes(raw: bytes) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "x.toml"

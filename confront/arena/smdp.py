@@ -203,6 +203,8 @@ class TeamBattleEnv:
         k = tank.enemy_slots if tank is not None else 1
         self._slots = np.full((b, r, k), -1, dtype=np.int64)  # which robot fills each enemy slot of the view
         self._memory = np.zeros((b, MEMORY_ROWS, r, r))  # each robot at each robot's last scan of it (tank.py)
+        self._mates = np.zeros((b, 3, r))  # x, y, energy of every robot one turn ago (team messages, tank.py)
+        self._mates_ok = np.zeros(b, dtype=np.bool_)  # False in a round's first turn: no message yet
         self._sensing = SENSING[self.config.observation.sensing]
         self._turn_buf = np.zeros((4, b, r))  # per turn: target, own energy, target energy, live
         self._kinds = self.bots.kinds.astype(np.int64) if self.bots is not None else np.zeros(r, np.int64)
@@ -275,7 +277,7 @@ class TeamBattleEnv:
         team_b = np.ascontiguousarray(np.broadcast_to(self.team, s.x.shape))
         tank_view_kernel(s.x, s.y, s.heading, s.velocity, s.energy, s.gun_heat, s.alive, team_b, self._memory,
                          s.scan_time, s.time.astype(np.float64), self.field[0], self.field[1], tank.enemy_slots,
-                         tank.mate_slots, view, self._slots)
+                         tank.mate_slots, self._mates, self._mates_ok, view, self._slots)
         return target, disc, view
 
     @property
@@ -292,6 +294,7 @@ class TeamBattleEnv:
             self.arena.seed(seed)
         self.arena.new_battle()
         self._memory[...] = 0.0
+        self._mates_ok[...] = False
         if self.bots is not None:
             self.bots.reset()
         target, disc, feats = self.observe()
@@ -304,6 +307,7 @@ class TeamBattleEnv:
         if m.any():
             self.arena.reset(m)  # scripted bots clear their memory on the new round themselves
             self._memory[m] = 0.0
+            self._mates_ok[m] = False
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats
@@ -376,7 +380,7 @@ class TeamBattleEnv:
                 self._memory, self._sensing)
         tank = self.config.tank
         view = (tank.enemy_slots, tank.mate_slots) if tank is not None else (0, 0)
-        tail = (rewards, self.max_distance, *obs, *view, self._slots)
+        tail = (rewards, self.max_distance, *obs, *view, self._mates, self._mates_ok, self._slots)
         if len(self._ranges) == 1:
             return _smdp_turns(0, self.n_battles, *head, *self._kargs, self._rems[0], *self._kargs_end, *tail)
         futures = [_pool().submit(_smdp_turns, lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
@@ -400,6 +404,7 @@ class TeamBattleEnv:
                 res.final_discrete, res.final_features = disc.copy(), feats.copy()
                 self.arena.reset(round_done)  # scripted bots clear their memory on the new round themselves
                 self._memory[round_done] = 0.0
+                self._mates_ok[round_done] = False
                 target, disc, feats = self.observe()
                 res.discrete, res.features, res.target = disc, feats, target
         self._last = (res.target, res.discrete, res.features)
@@ -411,6 +416,7 @@ class TeamBattleEnv:
         d = {f"arena.{k}": v for k, v in self.arena.state_dict().items()}
         d["control.memory"] = self._memory.copy()
         d["control.slots"] = self._slots.copy()
+        d["control.mates"], d["control.mates_ok"] = self._mates.copy(), self._mates_ok.copy()
         if self.bots is not None:
             d.update({f"bots.{k}": v for k, v in self.bots.state_dict().items()})
         return d
@@ -423,8 +429,9 @@ class TeamBattleEnv:
         if d["control.memory"].shape != self._memory.shape:
             raise ValueError(f"control.memory has shape {d['control.memory'].shape}, expected {self._memory.shape}")
         self._memory[...] = d["control.memory"]
-        if "control.slots" in d and d["control.slots"].shape == self._slots.shape:
-            self._slots[...] = d["control.slots"]
+        for name, arr in (("slots", self._slots), ("mates", self._mates), ("mates_ok", self._mates_ok)):
+            if f"control.{name}" in d and d[f"control.{name}"].shape == arr.shape:
+                arr[...] = d[f"control.{name}"]
         if self.bots is not None:
             self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
         self._last = self.observe()
@@ -443,7 +450,7 @@ def _purge_stale_cache() -> None:
     """
     here = Path(__file__).resolve()
     cache = here.parent / "__pycache__"
-    deps = ("_kernels.py", "bots.py", "rules.py", "state.py", "observe.py", "smdp.py")
+    deps = ("_kernels.py", "bots.py", "rules.py", "state.py", "observe.py", "tank.py", "smdp.py")
     h = hashlib.sha256()
     for name in deps:
         f = here.parent / name
@@ -569,7 +576,7 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
 def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
                 rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
                 placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
-                rewards, max_distance, target, disc, feats, view, k_slots, m_slots, slots):
+                rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
     per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of the team's
@@ -633,9 +640,13 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                       rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
                       rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
                       rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem)
-        if margin:
-            for b in range(b0, b1):
-                for i in range(n):
+        for b in range(b0, b1):  # what each robot broadcasts to its team-mates this turn (read next turn)
+            mates_ok[b] = True
+            for i in range(n):
+                mates[b, 0, i] = rf[b, K.X, i]
+                mates[b, 1, i] = rf[b, K.Y, i]
+                mates[b, 2, i] = rf[b, K.E, i]
+                if margin:
                     before[b - b0, i] = score[b, i].sum()
         # one Robocode turn of these battles (what Arena.step runs)
         K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
@@ -664,5 +675,5 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     if k_slots > 0:
         tank_view_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.V], rf[r, K.E], rf[r, K.HEAT], rb[r, K.ALIVE],
                          ri[r, K.TEAM], memory[r], scan_time[r], bi[r, K.TIME].astype(np.float64), width, height,
-                         k_slots, m_slots, view[r], slots[r])
+                         k_slots, m_slots, mates[r], mates_ok[r], view[r], slots[r])
     return t1

@@ -23,14 +23,15 @@ everything a real robot can know (its own getters, its radar's ScannedRobotEvent
 | +6 | its energy at the scan / 100 | [0, ~2] |
 | +7 | age of the scan, min(turns since, 50) / 50 | [0, 1] |
 | +8 | its energy drop between its last two scans, clip(drop, 0, 3) / 3 (it fired a bullet of that power) | [0, 1] |
-| per mate slot m (5 each): | the m-th nearest living team-mate, as it is (team messages) | |
+| per mate slot m (5 each): | the m-th nearest living team-mate, as its last message said (one turn ago) | |
 | +0 | 1 when the slot holds a team-mate | {0, 1} |
 | +1, +2 | sin, cos of its bearing from the own heading | [-1, 1] |
 | +3 | distance / field diagonal | [0, 1] |
 | +4 | its energy / 100 | [0, ~2] |
 
-Nothing names an opponent. The slot map ``slots`` (B, R, K) keeps which robot fills each enemy slot, so the
-action's target slot can be resolved to a robot.
+A team-mate is known from its team messages, which arrive the turn after they are sent: its x, y and energy
+one turn ago, and none in a round's first turn. Nothing names an opponent. The slot map ``slots`` (B, R, K)
+keeps which robot fills each enemy slot, so the action's target slot can be resolved to a robot.
 
 Tank actions: five heads, one joint integer ``(((d * n_turns + t) * n_fire + f) * K + k) * n_leads + l``
 (``np.ravel_multi_index`` over ``TankSpace.dims``): a move distance
@@ -173,12 +174,14 @@ def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, r
 @njit(cache=True)
 def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e: np.ndarray, heat: np.ndarray,
                   alive: np.ndarray, team: np.ndarray, i: int, memory: np.ndarray, seen: np.ndarray, time: float,
-                  width: float, height: float, k_slots: int, m_slots: int, out: np.ndarray,
-                  slots: np.ndarray) -> None:
+                  width: float, height: float, k_slots: int, m_slots: int, mates: np.ndarray, mates_ok: bool,
+                  out: np.ndarray, slots: np.ndarray) -> None:
     """Robot i's tank view of one battle's (R,) robots into ``out`` (F,), its enemy slots into ``slots`` (K,).
 
     An enemy is known while alive and scanned this round (``seen[i, j] >= 0``), at ``memory[:, i, j]``
-    (MEMORY_ROWS, R, R); team-mates as they are. Slots are filled nearest first (ties: lower index)."""
+    (MEMORY_ROWS, R, R); a living team-mate at ``mates[:, j]`` (3, R): x, y, energy one turn ago (a team
+    message arrives the turn after it is sent), none when not ``mates_ok`` (a round's first turn). Slots are
+    filled nearest first (ties: lower index)."""
     n = x.shape[0]
     diag = np.hypot(width, height)
     for q in range(out.shape[0]):
@@ -233,38 +236,39 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
         out[o + 6] = memory[M_E, i, best] / 100.0
         out[o + 7] = min(time - seen[i, best], MAX_AGE) / MAX_AGE
         out[o + 8] = min(max(memory[M_DROP, i, best], 0.0), 3.0) / 3.0
-    # team-mates: as they are (team messages)
+    # team-mates: as their last team messages said
     used[:] = False
-    for s in range(m_slots):
+    for s in range(m_slots if mates_ok else 0):
         best, best_d = -1, np.inf
         for j in range(n):
             if used[j] or j == i or team[j] != team[i] or not alive[j]:
                 continue
-            d = np.hypot(x[j] - x[i], y[j] - y[i])
+            d = np.hypot(mates[0, j] - x[i], mates[1, j] - y[i])
             if d < best_d:
                 best, best_d = j, d
         if best < 0:
             break
         used[best] = True
         o = OWN_FEATURES + ENEMY_FEATURES * k_slots + MATE_FEATURES * s
-        rel = np.arctan2(x[best] - x[i], y[best] - y[i]) - h[i]
+        rel = np.arctan2(mates[0, best] - x[i], mates[1, best] - y[i]) - h[i]
         out[o] = 1.0
         out[o + 1] = np.sin(rel)
         out[o + 2] = np.cos(rel)
         out[o + 3] = min(best_d / diag, 1.0)
-        out[o + 4] = e[best] / 100.0
+        out[o + 4] = mates[2, best] / 100.0
 
 
 @njit(cache=True)
 def tank_view_kernel(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e: np.ndarray,
                      heat: np.ndarray, alive: np.ndarray, team: np.ndarray, memory: np.ndarray, seen: np.ndarray,
-                     time: np.ndarray, width: float, height: float, k_slots: int, m_slots: int,
-                     feats: np.ndarray, slots: np.ndarray) -> None:
-    """Tank views (B, R, F) and enemy slot maps (B, R, K) of every robot of (B, R) arrays."""
+                     time: np.ndarray, width: float, height: float, k_slots: int, m_slots: int, mates: np.ndarray,
+                     mates_ok: np.ndarray, feats: np.ndarray, slots: np.ndarray) -> None:
+    """Tank views (B, R, F) and enemy slot maps (B, R, K) of every robot of (B, R) arrays; ``mates`` (B, 3, R)
+    and ``mates_ok`` (B,) as in :func:`tank_view_row`."""
     row = np.zeros(feats.shape[2])
     for b in range(x.shape[0]):
         for i in range(x.shape[1]):
             tank_view_row(x[b], y[b], h[b], v[b], e[b], heat[b], alive[b], team[b], i, memory[b], seen[b],
-                          float(time[b]), width, height, k_slots, m_slots, row, slots[b, i])
+                          float(time[b]), width, height, k_slots, m_slots, mates[b], mates_ok[b], row, slots[b, i])
             for q in range(row.shape[0]):
                 feats[b, i, q] = row[q]

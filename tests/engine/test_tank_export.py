@@ -41,21 +41,22 @@ def _env(turns: int, seed: int) -> TeamBattleEnv:
 
 def _knowledge(env: TeamBattleEnv, b: int, i: int) -> dict:
     """What robot i of battle b knows, as TankBot holds it: own state, counts, known enemies (robot order)
-    from its scan memory, living mates as they are."""
+    from its scan memory, living mates as their last team messages said (the env's one-turn-old copy)."""
     s, team = env.arena.state, env.team_ids()
     r = len(team)
     enemies = [j for j in range(r) if team[j] != team[i] and s.alive[b, j] and s.scan_time[b, i, j] >= 0]
-    mates = [j for j in range(r) if j != i and team[j] == team[i] and s.alive[b, j]]
+    mates = [j for j in range(r) if j != i and team[j] == team[i] and s.alive[b, j] and env._mates_ok[b]]
     return {
         "own": [float(v) for v in (s.x[b, i], s.y[b, i], s.heading[b, i], s.velocity[b, i], s.energy[b, i],
                                    s.gun_heat[b, i])],
         "guns": [float(s.gun_heading[b, i]), float(s.radar_heading[b, i])],
         "counts": [int(sum(s.alive[b, j] for j in range(r) if team[j] != team[i])), int(sum(team != team[i])),
-                   len(mates), int(sum(team == team[i]) - 1)],
+                   sum(1 for j in range(r) if j != i and team[j] == team[i] and s.alive[b, j]),
+                   int(sum(team == team[i]) - 1)],
         "ids": enemies,
         "enemies": [[*(float(v) for v in env._memory[b, :6, i, j]), float(s.scan_time[b, i, j]),
                      float(env._memory[b, 7, i, j])] for j in enemies],
-        "mates": [[float(s.x[b, j]), float(s.y[b, j]), float(s.energy[b, j])] for j in mates],
+        "mates": [[float(v) for v in env._mates[b, :, j]] for j in mates],
         "time": float(s.time[b]),
     }
 

@@ -440,10 +440,13 @@ class BridgeServer:
                 sock, _ = self._listener.accept()
             except (BlockingIOError, InterruptedError):
                 return
-            except OSError:
-                if self._stop.is_set():
-                    return
-                raise
+            except OSError as err:  # e.g. out of file descriptors: keep serving, try again in the next pass
+                if not self._stop.is_set():
+                    with self._lock:
+                        reason = f"accept failed: {err.strerror}"
+                        self.stats.rejected[reason] = self.stats.rejected.get(reason, 0) + 1
+                    time.sleep(0.01)  # the listener stays readable: do not spin
+                return
             sock.setblocking(False)
             while len(pending) >= MAX_PENDING:
                 self._drop(next(iter(pending)), pending, sel, "too many connections without a hello")

@@ -1,0 +1,168 @@
+"""The report of the recommended learner: trained PPO tank runs, evaluated per opponent in the simulator and
+(the exported TankBot, no Python) in the real engine, against the issue's targets.
+
+    python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine]
+
+Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
+simulator share (``--rounds`` rounds, the mean over runs with a t-interval when there are 2 or more), and with
+``--engine`` the exported robot's share in Robocode over ``--engine-seeds`` battles of ``--rounds`` rounds
+per sample-robot entry. Writes ``report.md``, ``results.json`` and the learning curves (share against
+decisions and against wall time, per opponent).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from confront.experiments.spec import config_from_dict, load_toml
+from confront.experiments.tanks import evaluate_tanks, load_tank_model
+from confront.runs import Run
+
+# the issue's targets per kind of entry: (share, what)
+TARGETS = {"1v1": 0.90, "4v4": 0.80, "4v4:td": 0.75, "4v4:dodge": 0.65}
+
+
+def target_of(entry: str) -> float | None:
+    """The share the issue asks for in this entry (engine), None where it names none."""
+    scen, _, opp = entry.partition(":")
+    if entry in TARGETS:
+        return TARGETS[entry]
+    if opp in ("self", "strafe", "random", "dodge", "td"):
+        return None
+    return TARGETS.get(scen)
+
+
+def mean_interval(values: list[float]) -> tuple[float, float, float]:
+    """Mean and a 95% t-interval (NaN bounds with fewer than 2 values)."""
+    from scipy import stats
+
+    v = np.asarray(values, dtype=float)
+    if len(v) < 2:
+        return float(v.mean()), math.nan, math.nan
+    lo, hi = stats.t.interval(0.95, len(v) - 1, loc=v.mean(), scale=stats.sem(v)) if v.std() > 0 else (v[0], v[0])
+    return float(v.mean()), float(lo), float(hi)
+
+
+def _curves(runs: list[Path], out: Path) -> list[Path]:
+    """Share per opponent against decisions and against wall time (200-round windows per opponent)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figs = []
+    for x_key, label in (("decisions", "agent decisions"), ("wall_s", "training wall time (s)")):
+        fig, ax = plt.subplots(figsize=(9, 5))
+        for run in runs[:1]:
+            rows = Run(run).read_table("rounds")
+            for name in sorted({r["opponent"] for r in rows}):
+                sub = [r for r in rows if r["opponent"] == name]
+                w = max(20, len(sub) // 30)
+                xs, ys = [], []
+                for i in range(0, len(sub) - w + 1, w):
+                    chunk = sub[i:i + w]
+                    o = sum(float(r["score_ours"]) for r in chunk)
+                    t = sum(float(r["score_theirs"]) for r in chunk)
+                    xs.append(float(chunk[-1][x_key]))
+                    ys.append(o / (o + t) if o + t else 0.5)
+                ax.plot(xs, ys, label=name, lw=1.2)
+        ax.axhline(0.5, color="k", ls=":", lw=0.8)
+        ax.set_xlabel(label)
+        ax.set_ylabel("score share (training, sampled actions)")
+        ax.set_title(f"PPO tanks: share per opponent against {label} (seed of {runs[0].name})")
+        ax.legend(fontsize=6, ncol=3)
+        path = out / f"share_vs_{x_key}.png"
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        figs.append(path)
+    return figs
+
+
+def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int) -> dict[str, Any]:
+    """Evaluate the runs and write the report; return the results."""
+    out.mkdir(parents=True, exist_ok=True)
+    cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
+    entries = list(cfgs[0].league.opponents)
+    sim: dict[str, list[float]] = {e: [] for e in entries}
+    for run, cfg in zip(runs, cfgs, strict=True):
+        res = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000)
+        for e in entries:
+            sim[e].append(res[e]["share"])
+    real: dict[str, list[float]] = {}
+    if engine:
+        from confront.arena.bots import BOT_NAMES
+        from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
+
+        policy = load_tank_policy(runs[0])
+        for e in entries:
+            scen, _, opp = e.partition(":")
+            if opp in BOT_NAMES:
+                real[e] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=k + 1)[1]
+                           for k in range(engine_seeds)]
+    summaries = [json.loads((r / "summary.json").read_text()) for r in runs]
+    lines = [
+        "# PPO tanks: the recommended learner, per opponent",
+        "",
+        f"Runs (training seeds): {', '.join(r.name for r in runs)}; each trained "
+        f"{', '.join(str(s['rounds']) for s in summaries)} rounds in "
+        f"{', '.join(format(s['wall_time_s'], '.0f') for s in summaries)} s "
+        f"({', '.join(format(s['decisions'], ',') for s in summaries)} decisions).",
+        f"Simulator: the greedy policy, {rounds} rounds per opponent (battle seed 10000)"
+        + (f"; mean and 95% t-interval over {len(runs)} training seeds." if len(runs) > 1 else
+           "; one training seed, so no interval over seeds."),
+        (f"Engine: the exported `confront.TankBot` jar (no Python) in Robocode 1.9.3.9, {engine_seeds} battles of "
+         f"{rounds} rounds per sample-robot entry (engine seeds 1..{engine_seeds}), the first run's policy."
+         if engine else "Engine: not run (pass --engine)."),
+        "Target: the issue's engine share for the entry; `met` compares the engine mean with it.",
+        "",
+        "| opponent | simulator | engine (battles) | engine mean | sim - engine | target | met |",
+        "|---|---:|---:|---:|---:|---:|:---:|",
+    ]
+    rows = []
+    for e in entries:
+        m, lo, hi = mean_interval(sim[e])
+        s_txt = f"{m:.3f}" + (f" [{lo:.3f}, {hi:.3f}]" if not math.isnan(lo) else "")
+        r = real.get(e)
+        tgt = target_of(e)
+        em = float(np.mean(r)) if r else math.nan
+        met = "" if tgt is None or not r else ("yes" if em >= tgt else "no")
+        lines.append(f"| {e} | {s_txt} | {' / '.join(f'{v:.3f}' for v in r) if r else '-'} | "
+                     f"{em:.3f} | {m - em:+.3f} | {tgt if tgt is not None else '-'} | {met} |"
+                     if r else f"| {e} | {s_txt} | - | - | - | {tgt if tgt is not None else '-'} | |")
+        rows.append({"entry": e, "sim": sim[e], "engine": r, "target": tgt})
+    figs = _curves(runs, out)
+    lines += ["", *[f"![{f.stem}]({f.name})" for f in figs], ""]
+    (out / "report.md").write_text("\n".join(lines) + "\n")
+    result = {"runs": [str(r) for r in runs], "rounds": rounds, "engine_seeds": engine_seeds if engine else 0,
+              "rows": rows}
+    (out / "results.json").write_text(json.dumps(result, indent=1))
+    return result
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="+", type=Path)
+    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--rounds", type=int, default=100)
+    ap.add_argument("--engine", action="store_true")
+    ap.add_argument("--engine-seeds", type=int, default=3)
+    args = ap.parse_args()
+    if args.rounds < 1 or args.engine_seeds < 1:
+        ap.error("--rounds and --engine-seeds must be at least 1")
+    for r in args.runs:
+        if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
+            ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")
+    res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds)
+    print((args.out / "report.md").read_text())
+    print(json.dumps({"report": str(args.out / "report.md"), "entries": len(res["rows"])}))
+
+
+if __name__ == "__main__":
+    main()

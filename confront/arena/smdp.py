@@ -64,7 +64,7 @@ from .observe import (
 )
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
-from .state import SCORE_PARTS
+from .state import HIT_ROBOT_SLOTS, SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_kernel
 
 __all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
@@ -639,7 +639,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                       rb[r, K.ALIVE], ri[r, K.TEAM], rf[r, K.DIST], rf[r, K.BODYREM], rf[r, K.GUNREM],
                       rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
                       rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
-                      rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem)
+                      rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem,
+                      rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.HEAT])
         for b in range(b0, b1):  # what each robot broadcasts to its team-mates this turn (read next turn)
             mates_ok[b] = True
             for i in range(n):

@@ -140,7 +140,7 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
     figs = _curves(runs, out)
     lines += ["", *[f"![{f.stem}]({f.name})" for f in figs], ""]
     (out / "report.md").write_text("\n".join(lines) + "\n")
-    result = {"runs": [str(r) for r in runs], "rounds": rounds, "engine_seeds": engine_seeds if engine else 0,
+    result = {"runs": [r.name for r in runs], "rounds": rounds, "engine_seeds": engine_seeds if engine else 0,
               "rows": rows}
     (out / "results.json").write_text(json.dumps(result, indent=1))
     return result

@@ -237,27 +237,34 @@ def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall
     compiled in as string constants, so the robot reads no file), ``PolicyBot.properties``, ``policy.txt``
     and the Java sources; a jar holds the same files and can be dropped into Robocode's robots folder.
     """
+    return write_robot(out, "PolicyBot", POLICY_CLASSES, "PolicyData", "policy.txt", policy.to_text(),
+                       "A policy trained with confront (fuzzy RL), exported with its own inference", install)
+
+
+def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str, policy_file: str, text: str,
+                description: str, install: EngineInstall | None = None) -> Path:
+    """A robot ``confront.<bot>`` as a robots folder or a ``.jar``: the project's compiled ``classes`` and their
+    sources, ``<bot>.properties``, the policy ``text`` as ``policy_file`` and compiled into the class ``data``
+    (string constants: the robot reads no file, in the engine's sandbox or from a jar)."""
     install = install or find_engine()
-    classes = compile_java(install)
+    compiled = compile_java(install)
     out = Path(out)
     with tempfile.TemporaryDirectory(prefix="confront-export-") as tmp:
         root = Path(tmp) / "robot" if out.suffix == ".jar" else out
         pkg = root / "confront"
         pkg.mkdir(parents=True, exist_ok=True)
         src = Path(__file__).parent / "java" / "confront"
-        for cls in POLICY_CLASSES:
-            shutil.copy2(classes / "confront" / f"{cls}.class", pkg / f"{cls}.class")
+        for cls in classes:
+            shutil.copy2(compiled / "confront" / f"{cls}.class", pkg / f"{cls}.class")
             shutil.copy2(src / f"{cls}.java", pkg / f"{cls}.java")
-        (pkg / "PolicyBot.properties").write_text(
-            "robot.classname=confront.PolicyBot\nrobot.name=PolicyBot\nrobot.version=1.0\n"
-            "robot.description=A policy trained with confront (fuzzy RL), exported with its own inference\n"
-            "robot.java.source.included=true\nrobocode.version=1.9.3.9\n"
+        (pkg / f"{bot}.properties").write_text(
+            f"robot.classname=confront.{bot}\nrobot.name={bot}\nrobot.version=1.0\n"
+            f"robot.description={description}\nrobot.java.source.included=true\nrobocode.version=1.9.3.9\n"
         )
-        text = policy.to_text()
-        (pkg / "policy.txt").write_text(text)
-        (pkg / "PolicyData.java").write_text(policy_data_source(text))
+        (pkg / policy_file).write_text(text)
+        (pkg / f"{data}.java").write_text(policy_data_source(text, name=data))
         proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),
-                               str(pkg / "PolicyData.java")], capture_output=True, text=True, check=False)
+                               str(pkg / f"{data}.java")], capture_output=True, text=True, check=False)
         if proc.returncode != 0:
             raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
         if out.suffix == ".jar":

@@ -21,8 +21,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import shutil
-import subprocess
 import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
@@ -33,9 +31,8 @@ import numpy as np
 from confront.arena.control import ControlConfig
 from confront.arena.observe import float_mod
 from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
-from confront.engine.export import policy_data_source
-from confront.engine.install import EngineInstall, find_engine
-from confront.engine.java_build import compile_java
+from confront.engine.export import write_robot
+from confront.engine.install import EngineInstall
 from confront.results import BattleResults
 
 __all__ = ["TankPolicy", "robot_view", "robot_target", "robot_control", "body_turn", "turn_rate",
@@ -256,35 +253,8 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
     It holds ``confront/TankBot.class``, ``TankModel.class``, ``RoundStart.class``, ``TankData.class`` (the
     policy as string constants, so the robot reads no file), ``TankBot.properties``, ``tank_policy.txt``
     and the Java sources."""
-    install = install or find_engine()
-    classes = compile_java(install)
-    out = Path(out)
-    with tempfile.TemporaryDirectory(prefix="confront-tank-export-") as tmp:
-        root = Path(tmp) / "robot" if out.suffix == ".jar" else out
-        pkg = root / "confront"
-        pkg.mkdir(parents=True, exist_ok=True)
-        src = Path(__file__).parent / "java" / "confront"
-        for cls in TANK_CLASSES:
-            shutil.copy2(classes / "confront" / f"{cls}.class", pkg / f"{cls}.class")
-            shutil.copy2(src / f"{cls}.java", pkg / f"{cls}.java")
-        (pkg / "TankBot.properties").write_text(
-            "robot.classname=confront.TankBot\nrobot.name=TankBot\nrobot.version=1.0\n"
-            "robot.description=A tank policy trained with confront (PPO), exported with its own inference\n"
-            "robot.java.source.included=true\nrobocode.version=1.9.3.9\n"
-        )
-        text = policy.to_text()
-        (pkg / "tank_policy.txt").write_text(text)
-        (pkg / "TankData.java").write_text(policy_data_source(text, name="TankData"))
-        proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),
-                               str(pkg / "TankData.java")], capture_output=True, text=True, check=False)
-        if proc.returncode != 0:
-            raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
-        if out.suffix == ".jar":
-            jar = shutil.which("jar") or str(Path(install.javac).with_name("jar"))
-            out.parent.mkdir(parents=True, exist_ok=True)
-            subprocess.run([jar, "cf", str(out.resolve()), "-C", str(root), "."], check=True,
-                           capture_output=True)
-    return out
+    return write_robot(out, "TankBot", TANK_CLASSES, "TankData", "tank_policy.txt", policy.to_text(),
+                       "A tank policy trained with confront (PPO), exported with its own inference", install)
 
 
 def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,

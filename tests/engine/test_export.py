@@ -20,6 +20,11 @@ from confront.engine.runner import EngineOptions, run_battle
 HELLO = {"name": "me", "team": "", "width": 800.0, "height": 600.0}
 
 
+def _parse(line: str) -> Observation:
+    """An observation line on the connection of its own round (the bridge checks the round)."""
+    return parse_observation(line, {**HELLO, "round": int(line.split("\t")[0].split(" ")[1])})
+
+
 def _q_policy(seed: int = 0) -> ExportedPolicy:
     return ExportedPolicy("qtable", q=np.random.default_rng(seed).normal(size=(320, 4)))
 
@@ -87,7 +92,7 @@ def _java_decisions(install, policy: ExportedPolicy, lines: list[str], tmp_path)
 def _compare(policy: ExportedPolicy, lines: list[str], java: list[list[float]]) -> None:
     assert len(java) == len(lines)
     for line, (a, gun, radar, fire, state) in zip(lines, java, strict=True):
-        obs = parse_observation(line, HELLO)
+        obs = _parse(line)
         assert policy.act(obs) == int(a), line
         assert policy.state_and_features(obs)[0] == int(state), line
         pg, pr, pf = policy.gun_radar(obs)
@@ -133,7 +138,7 @@ def test_export_twin_equals_the_simulator_on_its_own_observations() -> None:
     lines, expected = _sim_observations()
     unknown = stale = fired = 0
     for line, (state, gun, radar, fire) in zip(lines, expected, strict=True):
-        obs = parse_observation(line, HELLO)
+        obs = _parse(line)
         assert policy.state_and_features(obs)[0] == state, line
         pg, pr, pf = policy.gun_radar(obs)
         assert (math.isnan(pg) and math.isnan(gun)) or gun == pytest.approx(pg, abs=1e-12), line
@@ -225,7 +230,7 @@ def test_policy_from_learner_decides_like_the_learner(kind: str) -> None:
     rng = np.random.default_rng(0)
     acts = set()
     for line in _random_observations(150, seed=11):
-        obs = parse_observation(line, HELLO)
+        obs = _parse(line)
         x = policy.learner_observation(obs, learner.observation)
         q = learner.q_values(x)[0] if hasattr(learner, "q_values") else learner.q[x[0]]
         scale = getattr(learner.params, "q_scale", 1.0)

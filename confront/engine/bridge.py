@@ -325,6 +325,7 @@ class BridgeStats:
     rounds_ended: int = 0
     errors: list[str] = field(default_factory=list)
     errors_dropped: int = 0
+    resets: int = 0  # sessions the robot's side reset: the engine stops robot threads at a round's end
     rejected: dict[str, int] = field(default_factory=dict)
     policy_s: float = 0.0  # time inside the policy
     handling_s: float = 0.0  # the server's own time per decision: parse, format, send (policy excluded)
@@ -571,6 +572,9 @@ class BridgeServer:
                         self.stats.decisions += 1
                         self.stats.policy_s += t2 - t1
                         self.stats.handling_s += (parsed - t0) + (t3 - t2)
+        except ConnectionResetError:  # Robocode stopped the robot's thread mid-exchange (a round's end): counted
+            with self._lock:
+                self.stats.resets += 1
         except OSError as err:
             if not self._stop.is_set():
                 self._error(f"{hello['name']}: connection: {err}")

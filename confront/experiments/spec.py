@@ -131,6 +131,16 @@ class TankSection:
                                    "between scans)")
     reward: Literal["score", "eq35"] = field("score", doc="team's Robocode score margin per turn, or Eq. 35")
 
+    def __post_init__(self) -> None:
+        for key in ("distances", "turns_deg", "fire_powers", "leads"):
+            if not getattr(self, key):
+                raise ValueError(f"tank.{key} must not be empty")
+        if any(p != 0 and not 0.1 <= p <= 3.0 for p in self.fire_powers):
+            raise ValueError(f"tank.fire_powers = {list(self.fire_powers)} is not allowed: use 0 (hold) or 0.1..3")
+        bad = [v for v in self.leads if v not in ("none", "linear", "circular")]
+        if bad:
+            raise ValueError(f"tank.leads entry {bad[0]!r} is not allowed: use none, linear or circular")
+
 
 @dataclass
 class PPOSection:

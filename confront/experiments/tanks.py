@@ -349,12 +349,13 @@ def tank_sessions(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]
     return out
 
 
-def train_tanks(cfg: ExperimentConfig, run: Run, resume: bool = False, progress: bool = True) -> dict[str, Any]:
+def train_tanks(cfg: ExperimentConfig, run: Run, resume: bool = False, progress: bool = True,
+                trainer: TankTrainer | None = None) -> dict[str, Any]:
     """Train PPO tanks into ``run`` (or continue it); write metrics, model, plots; return the summary."""
     from torch.utils.tensorboard import SummaryWriter
     from tqdm import tqdm
 
-    trainer = TankTrainer(cfg, progress=progress)
+    trainer = trainer or TankTrainer(cfg, progress=progress)
     if resume:
         latest = ck.latest(run.checkpoints)
         if latest is not None:

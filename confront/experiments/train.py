@@ -384,9 +384,14 @@ def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool
     else:
         run = new_run(cfg, out, exist_ok)
     if cfg.learner.kind == "ppo":  # the recommended learner: its own rollout loop over the league (tanks.py)
-        from confront.experiments.tanks import train_tanks
+        from confront.experiments.tanks import TankTrainer, train_tanks
 
-        return train_tanks(cfg, run, resume=resume, progress=progress)
+        try:
+            trainer = TankTrainer(cfg, progress=progress)
+        except Exception:
+            run.discard_if_new()  # a failed start leaves no half-made run folder
+            raise
+        return train_tanks(cfg, run, resume=resume, progress=progress, trainer=trainer)
     try:
         loop, info = _setup(cfg, progress)
     except Exception:

@@ -123,3 +123,18 @@ def test_report_targets_and_intervals() -> None:
     m, lo, hi = mean_interval([0.8, 0.9, 1.0])
     assert m == pytest.approx(0.9) and lo == pytest.approx(0.9 - 4.302653 * 0.1 / math.sqrt(3), rel=1e-5)
     assert math.isnan(mean_interval([0.5])[1])
+
+
+@pytest.mark.parametrize(("override", "message"), [
+    ('league.opponents=["1v1:nope"]', "league.opponents entry '1v1:nope'"),
+    ('tank.leads=["sideways"]', "tank.leads entry 'sideways'"),
+    ("tank.fire_powers=[0.05]", "tank.fire_powers"),
+])
+def test_bad_tank_configs_are_one_line_errors(tmp_path, override: str, message: str) -> None:
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "confront.cli.main", "train", "-c", "tanks", "--set", override,
+                           "--out", str(tmp_path / "run")], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and message in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "run").exists()

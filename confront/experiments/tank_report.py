@@ -107,43 +107,54 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
                 real[e] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=k + 1)[1]
                            for k in range(engine_seeds)]
     summaries = [json.loads((r / "summary.json").read_text()) for r in runs]
+    result = {"runs": [r.name for r in runs], "rounds": rounds, "engine_seeds": engine_seeds if engine else 0,
+              "trained": [{k: s[k] for k in ("rounds", "wall_time_s", "decisions")} for s in summaries],
+              "rows": [{"entry": e, "sim": sim[e], "engine": real.get(e), "target": target_of(e)} for e in entries]}
+    (out / "results.json").write_text(json.dumps(result, indent=1))
+    _curves(runs, out)
+    write_markdown(result, out)
+    return result
+
+
+def write_markdown(result: dict[str, Any], out: Path) -> Path:
+    """``report.md`` from ``results.json``'s content (the figures beside it)."""
+    runs, trained, rounds, seeds = result["runs"], result["trained"], result["rounds"], result["engine_seeds"]
     lines = [
         "# PPO tanks: the recommended learner, per opponent",
         "",
-        f"Runs (training seeds): {', '.join(r.name for r in runs)}; each trained "
-        f"{', '.join(str(s['rounds']) for s in summaries)} rounds in "
-        f"{', '.join(format(s['wall_time_s'], '.0f') for s in summaries)} s "
-        f"({', '.join(format(s['decisions'], ',') for s in summaries)} decisions).",
+        f"Runs (training seeds): {', '.join(runs)}; each trained "
+        f"{', '.join(str(s['rounds']) for s in trained)} rounds in "
+        f"{', '.join(format(s['wall_time_s'], '.0f') for s in trained)} s "
+        f"({', '.join(format(s['decisions'], ',') for s in trained)} decisions).",
         f"Simulator: the greedy policy, {rounds} rounds per opponent (battle seed 10000)"
-        + (f"; mean and 95% t-interval over {len(runs)} training seeds." if len(runs) > 1 else
-           "; one training seed, so no interval over seeds."),
-        (f"Engine: the exported `confront.TankBot` jar (no Python) in Robocode 1.9.3.9, {engine_seeds} battles of "
-         f"{rounds} rounds per sample-robot entry (engine seeds 1..{engine_seeds}), the first run's policy."
-         if engine else "Engine: not run (pass --engine)."),
+        + (f"; mean and 95% t-interval over {len(runs)} training seeds, then the first run alone." if len(runs) > 1
+           else "; one training seed, so no interval over seeds."),
+        (f"Engine: the exported `confront.TankBot` jar (no Python) in Robocode 1.9.3.9, {seeds} battles of "
+         f"{rounds} rounds per sample-robot entry (engine seeds 1..{seeds}), the first run's policy; `sim - engine` "
+         "compares that same policy." if seeds else "Engine: not run (pass --engine)."),
         "Target: the issue's engine share for the entry; `met` compares the engine mean with it.",
         "",
-        "| opponent | simulator | engine (battles) | engine mean | sim - engine | target | met |",
-        "|---|---:|---:|---:|---:|---:|:---:|",
+        f"| opponent | simulator, {len(runs)} seeds | simulator, {runs[0]} | engine, {runs[0]} (battles) | engine mean "
+        "| sim - engine | target | met |",
+        "|---|---:|---:|---:|---:|---:|---:|:---:|",
     ]
-    rows = []
-    for e in entries:
-        m, lo, hi = mean_interval(sim[e])
+    for row in result["rows"]:
+        e, sim, r, tgt = row["entry"], row["sim"], row["engine"], row["target"]
+        m, lo, hi = mean_interval(sim)
         s_txt = f"{m:.3f}" + (f" [{lo:.3f}, {hi:.3f}]" if not math.isnan(lo) else "")
-        r = real.get(e)
-        tgt = target_of(e)
-        em = float(np.mean(r)) if r else math.nan
-        met = "" if tgt is None or not r else ("yes" if em >= tgt else "no")
-        lines.append(f"| {e} | {s_txt} | {' / '.join(f'{v:.3f}' for v in r) if r else '-'} | "
-                     f"{em:.3f} | {m - em:+.3f} | {tgt if tgt is not None else '-'} | {met} |"
-                     if r else f"| {e} | {s_txt} | - | - | - | {tgt if tgt is not None else '-'} | |")
-        rows.append({"entry": e, "sim": sim[e], "engine": r, "target": tgt})
-    figs = _curves(runs, out)
+        t_txt = "-" if tgt is None else f"{tgt:.2f}"
+        if r:
+            em = float(np.mean(r))
+            met = "" if tgt is None else ("yes" if em >= tgt else "no")
+            lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | {' / '.join(f'{v:.3f}' for v in r)} | {em:.3f} | "
+                         f"{sim[0] - em:+.3f} | {t_txt} | {met} |")
+        else:
+            lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | - | - | - | {t_txt} | |")
+    figs = sorted(out.glob("share_vs_*.png"))
     lines += ["", *[f"![{f.stem}]({f.name})" for f in figs], ""]
-    (out / "report.md").write_text("\n".join(lines) + "\n")
-    result = {"runs": [r.name for r in runs], "rounds": rounds, "engine_seeds": engine_seeds if engine else 0,
-              "rows": rows}
-    (out / "results.json").write_text(json.dumps(result, indent=1))
-    return result
+    path = out / "report.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
 
 
 def main() -> None:

@@ -22,14 +22,13 @@ def measure(opponents: list[str], battles: int, updates: int) -> dict[str, float
     env = upd = 0.0
     for _ in range(updates):
         row = trainer.update()
-        dt = row["decisions"] / max(row["decisions_per_s"], 1e-9)
         env += row["env_fraction"]
         upd += row["update_fraction"]
     wall = time.perf_counter() - t0
     n = trainer.decisions - d0
     return {"league": ",".join(opponents), "agents": trainer.pool.n_agents, "decisions": n,
             "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
-            "env_fraction": env / updates, "update_fraction": upd / updates, "wall_s": wall, "_dt": dt}
+            "env_fraction": env / updates, "update_fraction": upd / updates, "wall_s": wall}
 
 
 def main() -> None:
@@ -48,8 +47,7 @@ def main() -> None:
     for r in rows:
         print(f"| {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | {r['decisions_per_cpu_s']:,.0f} | "
               f"{r['env_fraction']:.0%} | {r['update_fraction']:.0%} |")
-    print(json.dumps({"bench": "train", "load": os.getloadavg()[0],
-                      "rows": [{k: v for k, v in r.items() if not k.startswith("_")} for r in rows]}))
+    print(json.dumps({"bench": "train", "load": os.getloadavg()[0], "rows": rows}))
 
 
 if __name__ == "__main__":

@@ -36,6 +36,8 @@ from typing import Literal
 import numpy as np
 from numba import njit, vectorize
 
+from .tank import M_DROP, M_E, M_H, M_SEEN, M_TIME, M_TURN, M_V, MEMORY_ROWS
+
 N_REL_BINS = 4
 N_HEADING_BINS = 4
 N_DIST_BINS = 20
@@ -270,21 +272,21 @@ def remember_scans(scanned: np.ndarray, x: np.ndarray, y: np.ndarray, e: np.ndar
     scan of j this round, the scanned flag, the turn rate since that scan (within the +-10 deg/turn of
     Rules.MAX_TURN_RATE) and the scan time."""
     n = x.shape[0]
-    full = memory.shape[0] >= 9
+    full = memory.shape[0] >= MEMORY_ROWS
     max_rate = np.pi / 18.0
     for i in range(n):
         for j in range(n):
             if scanned[i, j]:
                 if full:
-                    seen = memory[6, i, j] > 0
-                    memory[5, i, j] = memory[2, i, j] - e[j] if seen else 0.0
-                    dt = time - memory[8, i, j]
-                    dh = float_mod(h[j] - memory[3, i, j] + np.pi, 2 * np.pi) - np.pi
-                    memory[7, i, j] = min(max(dh / dt, -max_rate), max_rate) if seen and dt > 0 else 0.0
-                    memory[3, i, j] = h[j]
-                    memory[4, i, j] = v[j]
-                    memory[6, i, j] = 1.0
-                    memory[8, i, j] = time
+                    seen = memory[M_SEEN, i, j] > 0
+                    memory[M_DROP, i, j] = memory[M_E, i, j] - e[j] if seen else 0.0
+                    dt = time - memory[M_TIME, i, j]
+                    dh = float_mod(h[j] - memory[M_H, i, j] + np.pi, 2 * np.pi) - np.pi
+                    memory[M_TURN, i, j] = min(max(dh / dt, -max_rate), max_rate) if seen and dt > 0 else 0.0
+                    memory[M_H, i, j] = h[j]
+                    memory[M_V, i, j] = v[j]
+                    memory[M_SEEN, i, j] = 1.0
+                    memory[M_TIME, i, j] = time
                 memory[0, i, j] = x[j]
                 memory[1, i, j] = y[j]
                 memory[2, i, j] = e[j]

@@ -65,7 +65,7 @@ from .observe import (
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
 from .state import HIT_ROBOT_SLOTS, SCORE_PARTS
-from .tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_kernel
+from .tank import M_H, M_TURN, M_V, MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_kernel
 
 __all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
 
@@ -250,13 +250,9 @@ class TeamBattleEnv:
 
     @property
     def action_dims(self) -> tuple[int, ...]:
-        """Sizes of the action heads whose mixed-radix product is the joint action (tank actions: 4 heads)."""
+        """Sizes of the action heads whose mixed-radix product is the joint action (tank actions: 5 heads)."""
         tank = self.config.tank
         return tank.dims if tank is not None else (self.n_actions,)
-
-    def opponent_n_actions(self) -> int:
-        """Actions of the caller-driven opponents (``opponent_actions``)."""
-        return int(self._n_act[1])
 
     @property
     def turns_per_step(self) -> int:
@@ -293,8 +289,7 @@ class TeamBattleEnv:
         if seed is not None:
             self.arena.seed(seed)
         self.arena.new_battle()
-        self._memory[...] = 0.0
-        self._mates_ok[...] = False
+        self._forget(np.ones(self.n_battles, dtype=bool))
         if self.bots is not None:
             self.bots.reset()
         target, disc, feats = self.observe()
@@ -306,11 +301,15 @@ class TeamBattleEnv:
         m = np.asarray(mask, dtype=bool)
         if m.any():
             self.arena.reset(m)  # scripted bots clear their memory on the new round themselves
-            self._memory[m] = 0.0
-            self._mates_ok[m] = False
+            self._forget(m)
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats
+
+    def _forget(self, mask: np.ndarray) -> None:
+        """A new round in the masked battles (B,): no scans remembered, no team message received yet."""
+        self._memory[mask] = 0.0
+        self._mates_ok[mask] = False
 
     def start_recording(self, battle: int = 0, names: list[str] | None = None) -> Replay:
         """Record battle ``battle`` turn by turn into a new :class:`Replay` (until stop_recording)."""
@@ -403,8 +402,7 @@ class TeamBattleEnv:
             if self.config.auto_reset:
                 res.final_discrete, res.final_features = disc.copy(), feats.copy()
                 self.arena.reset(round_done)  # scripted bots clear their memory on the new round themselves
-                self._memory[round_done] = 0.0
-                self._mates_ok[round_done] = False
+                self._forget(round_done)
                 target, disc, feats = self.observe()
                 res.discrete, res.features, res.target = disc, feats, target
         self._last = (res.target, res.discrete, res.features)
@@ -430,8 +428,11 @@ class TeamBattleEnv:
             raise ValueError(f"control.memory has shape {d['control.memory'].shape}, expected {self._memory.shape}")
         self._memory[...] = d["control.memory"]
         for name, arr in (("slots", self._slots), ("mates", self._mates), ("mates_ok", self._mates_ok)):
-            if f"control.{name}" in d and d[f"control.{name}"].shape == arr.shape:
-                arr[...] = d[f"control.{name}"]
+            saved = d.get(f"control.{name}")
+            if saved is None or saved.shape != arr.shape:
+                got = "missing" if saved is None else f"shape {saved.shape}"
+                raise ValueError(f"control.{name} is {got}, expected shape {arr.shape}")
+            arr[...] = saved
         if self.bots is not None:
             self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
         self._last = self.observe()
@@ -474,9 +475,9 @@ C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = r
 
 def _action_tables(cfg: SMDPConfig, learner: np.ndarray, team: np.ndarray, opponent_actions: str
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Action tables (2, A, 6) of (distance, body turn, fire power, target slot, relative turn, lead) rows, 0 = the
-    learners',
-    1 = the caller-driven opponents'; each robot's table (R,) (-1: scripted); actions per table (2,).
+    """Action tables (2, A, 6) of (distance, body turn, fire power, target slot, relative turn, lead) rows,
+    0 = the learners', 1 = the caller-driven opponents'; each robot's table (R,) (-1: scripted); actions per
+    table (2,).
     Fire power 0 = by distance (the paper's controller), -1 = hold fire; slot -1 = the target rule's."""
     dist, turn = move_commands(np.arange(N_MOVES), cfg.control)
     a = np.arange(cfg.paper_actions)
@@ -579,8 +580,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
-    per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of the team's
-    score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
+    per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of
+    the team's score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
     disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0). Returns the turn index
     where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
     run in parallel threads. Each robot picks its target and aims from its own picture
@@ -621,10 +622,10 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                         tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
                         if tg >= 0 and move[b, i, 3] > 0 and sensing == 1:
                             aim_power = power[b, i] if power[b, i] > 0 else 2.0
-                            rate = memory[b, 7, i, tg] if move[b, i, 3] > 1 else 0.0
-                            tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, 3, i, tg],
-                                                memory[b, 4, i, tg], rate, float(bi[b, K.TIME] - scan_time[b, i, tg]),
-                                                aim_power, width, height)
+                            rate = memory[b, M_TURN, i, tg] if move[b, i, 3] > 1 else 0.0
+                            tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, M_H, i, tg],
+                                                memory[b, M_V, i, tg], rate,
+                                                float(bi[b, K.TIME] - scan_time[b, i, tg]), aim_power, width, height)
                         controller_turn(rf, b, i, tg, tx, ty, ctrl, power[b, i], cmd)
                 else:
                     for c in range(4):
@@ -641,14 +642,15 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                       rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
                       rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem,
                       rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.HEAT])
-        for b in range(b0, b1):  # what each robot broadcasts to its team-mates this turn (read next turn)
-            mates_ok[b] = True
-            for i in range(n):
-                mates[b, 0, i] = rf[b, K.X, i]
-                mates[b, 1, i] = rf[b, K.Y, i]
-                mates[b, 2, i] = rf[b, K.E, i]
-                if margin:
-                    before[b - b0, i] = score[b, i].sum()
+        if k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
+            for b in range(b0, b1):
+                mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
+                for i in range(n):
+                    mates[b, 0, i] = rf[b, K.X, i]
+                    mates[b, 1, i] = rf[b, K.Y, i]
+                    mates[b, 2, i] = rf[b, K.E, i]
+                    if margin:
+                        before[b - b0, i] = score[b, i].sum()
         # one Robocode turn of these battles (what Arena.step runs)
         K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                      placements, placements_total, cmd, params, scratch_i, scratch_f)

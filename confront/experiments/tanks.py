@@ -33,7 +33,7 @@ from confront import checkpoint as ck
 from confront.arena.observe import N_DIST_BINS, N_HEADING_BINS, ObservationConfig
 from confront.arena.pool import PoolEntry, PoolEnv, PoolStep
 from confront.arena.smdp import SMDPConfig
-from confront.arena.tank import OWN_FEATURES, TankSpace
+from confront.arena.tank import FEATURE_NAMES, OWN_FEATURES, TankSpace
 from confront.experiments.spec import ExperimentConfig
 from confront.learning.ppo import PPO, PPOConfig, Rollout
 from confront.runs import Run
@@ -252,11 +252,13 @@ class TankTrainer:
         self.snap.load(self.snapshots[int(self.pool.rng.integers(len(self.snapshots)))])
 
     def _critic(self, obs: np.ndarray) -> np.ndarray:
-        return self.ppo.critic_input(obs, self.pool.group, self.pool.n_groups, obs[:, 7] > 0)
+        alive = obs[:, FEATURE_NAMES.index("energy")] > 0  # a dead tank has no energy
+        return self.ppo.critic_input(obs, self.pool.group, self.pool.n_groups, alive)
 
     def update(self) -> dict[str, Any]:
         """One rollout of S steps and one PPO update; returns the update's log row."""
         t0 = time.perf_counter()
+        first_row = len(self.rows)
         c, pool = self.ppo.config, self.pool
         self._pick_snapshot()
         s, n = c.rollout_steps, pool.n_agents
@@ -290,8 +292,8 @@ class TankTrainer:
         row = {"update": self.ppo.updates, "rounds": self.rounds_done, "decisions": self.decisions,
                "wall_s": self.elapsed, "decisions_per_s": float(buf.active.sum()) / dt,
                "env_fraction": t_env / dt, "update_fraction": (time.perf_counter() - t_up) / dt, **stats}
-        for r in self.rows[-200:]:
-            r.setdefault("wall_s", self.elapsed)
+        for r in self.rows[first_row:]:  # the rounds that ended in this update, at its end
+            r["wall_s"] = self.elapsed
         self.updates.append(row)
         return row
 

@@ -268,7 +268,8 @@ class SB3Policy(Learner):
 
 # -- one (method, seed) ------------------------------------------------------------------------------------------
 
-def _experiment(cfg: BaselinesConfig, seed: int, rounds: int) -> Any:
+def baseline_experiment(cfg: BaselinesConfig, seed: int, rounds: int) -> Any:
+    """The baselines' experiment (the paper's 4v4 against the TD team) at ``seed`` for ``rounds`` rounds."""
     from confront.experiments.spec import load_experiment
 
     return load_experiment(cfg.base, cfg.overrides + (f"train.seed={seed}", f"train.rounds={rounds}",
@@ -322,7 +323,7 @@ def train_sb3(algo: str, cfg: BaselinesConfig, seed: int, rounds: int) -> tuple[
     if algo not in SB3_METHODS:
         raise ValueError(f"algo must be one of {', '.join(SB3_METHODS)}, got {algo!r}")
     torch.set_num_threads(1)
-    exp = _experiment(cfg, seed, rounds)
+    exp = baseline_experiment(cfg, seed, rounds)
     smdp = smdp_config(exp)
     td, td_path = td_team(exp, smdp.n_actions)
     env = SharedTeamVecEnv(scenario_of(exp.arena.scenario), exp.arena.battles, seed, "td", td, smdp)
@@ -363,7 +364,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
     done = folder / "result.json"
     if done.exists():
         return json.loads(done.read_text())
-    exp = _experiment(cfg, seed, rounds)
+    exp = baseline_experiment(cfg, seed, rounds)
     extra: dict[str, Any] = {"train_rounds": 0, "train_seconds": 0.0}
     policy: Learner | None = None
     scripted = ""

@@ -105,7 +105,8 @@ def run_sweep(grid: str | Path, out: str | Path, address: str | None = None, see
         if not ray.is_initialized():
             ray.init(address=address, num_cpus=num_cpus if address is None else None,
                      include_dashboard=False, log_to_driver=False)
-        remote = ray.remote(num_cpus=1)(run_trial)
+        # one CPU a trial: its simulator and torch run one thread (CONFRONT_THREADS), so trials do not oversubscribe
+        remote = ray.remote(num_cpus=1, runtime_env={"env_vars": {"CONFRONT_THREADS": "1"}})(run_trial)
         pending = {remote.remote(base, t, out): t for t in todo}
         from tqdm import tqdm
 

@@ -60,3 +60,40 @@ def test_sweep_runs_and_resumes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch)
         assert "final score ratio" in (out / "results.md").read_text()
     finally:
         ray.shutdown()
+
+
+PPO_GRID = """
+experiment = "tanks-demo"
+seeds = 1
+[set]
+"train.rounds" = 24
+"train.session_rounds" = 8
+"train.checkpoint_every" = 8
+"league.opponents" = ["1v1:SittingDuck", "4v4:SpinBot"]
+"league.battles" = 2
+"ppo.rollout_steps" = 8
+[grid]
+"ppo.lr" = [0.001, 0.003]
+"""
+
+
+def test_sweep_trains_ppo_tanks(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The recommended learner goes through the same sweep: PPO trial folders with models, resumable."""
+    monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path / "cache"))
+    g = tmp_path / "grid.toml"
+    g.write_text(PPO_GRID)
+    out = tmp_path / "sweep"
+    try:
+        rows = run_sweep(g, out, num_cpus=2)
+        assert sorted(r["point"] for r in rows) == ["lr=0.001", "lr=0.003"]
+        for name in ("lr=0.001-s0", "lr=0.003-s0"):
+            trial = out / "trials" / name
+            summary = json.loads((trial / "summary.json").read_text())
+            assert summary["learner"] == "ppo" and summary["rounds"] >= 24
+            assert json.loads((trial / "model" / "model.json").read_text())["kind"] == "ppo"
+            assert (trial / "model" / "actor.npz").is_file()
+            assert any((trial / "checkpoints").glob("round-*"))  # league snapshots and learner as data
+        fast = json.loads((out / "trials" / "lr=0.003-s0" / "summary.json").read_text())
+        assert 0.0 <= fast["final_score_ratio"] <= 1.0
+    finally:
+        ray.shutdown()

@@ -125,6 +125,27 @@ def test_report_targets_and_intervals() -> None:
     assert math.isnan(mean_interval([0.5])[1])
 
 
+def test_compare_entries_and_paired_verdicts(tmp_path) -> None:
+    from confront.experiments.tank_compare import METHODS, OURS, compare_entries, write_markdown
+
+    league = ("1v1:SpinBot", "1v1:dodge", "1v1:self", "4v4:td", "1v1:td", "4v4:Walls", "4v10:SpinBot")
+    assert compare_entries(league) == ["1v1:SpinBot", "4v4:td", "4v4:Walls"]
+    # 5 seeds, ours ahead of every method by 0.1 on each: the sign-flip p is 1/32 (all 32 flips enumerated)
+    from confront.experiments.stats import paired_comparison
+
+    ours = np.array([0.9, 0.8, 0.85, 0.95, 0.7])
+    pc = paired_comparison(ours, ours - 0.1, np.random.default_rng(0))
+    assert pc.diff.mean == pytest.approx(0.1) and pc.p == pytest.approx(1 / 32, abs=0.01)
+    entries = ["1v1:SpinBot", "4v4:td"]
+    shares = {m: {e: list(ours - (0.1 if m != OURS else 0.0)) for e in entries} for m in (OURS, *METHODS)}
+    tests = {m: {"1v1:SpinBot": {"diff": 0.1, "lo": 0.1, "hi": 0.1, "p": 1 / 32},
+                 "4v4:td": {"diff": 0.1, "lo": -0.1, "hi": 0.3, "p": 0.2}} for m in METHODS}
+    md = write_markdown({"seeds": [0, 1, 2, 3, 4], "rounds": 10, "train_rounds": 500, "entries": entries,
+                         "shares": shares, "tests": tests}, tmp_path).read_text()
+    assert "| 1v1:SpinBot | 0.840 | 0.740 |" in md
+    assert f"{METHODS[0]} on 1 of 2 entries" in md
+
+
 @pytest.mark.parametrize(("override", "message"), [
     ('league.opponents=["1v1:nope"]', "league.opponents entry '1v1:nope'"),
     ('tank.leads=["sideways"]', "tank.leads entry 'sideways'"),

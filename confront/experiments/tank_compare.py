@@ -1,0 +1,207 @@
+"""PPO tanks against the paper's method, SB3 PPO and random moves, matchup by matchup, paired over training seeds.
+
+    python -m confront.experiments.tank_compare RUN [RUN ...] --out docs/results/tanks [--rounds 100]
+
+Each RUN is a PPO tanks run (``confront train -c tanks --set train.seed=K``); its seed K is the pairing key.
+For every seed K the other methods are trained as ``confront reproduce baselines`` trains them (the paper's
+4v4 against the seed's TD team, 500 rounds, the paper's state and four moves, T = 10):
+
+- ``DMNN (FLM)``: the paper's method (DMNN, adaptive momentum, fuzzy learning rate, SSAQ);
+- ``PPO (SB3)``: Stable-Baselines3's PPO shared by the team's tanks (:func:`baselines.train_sb3`);
+- ``Random moves``: each tank picks one of the paper's four moves at random (no training).
+
+Then every method plays ``--rounds`` greedy rounds per league entry that names a sample robot or the TD team,
+in the simulator: PPO tanks through :func:`tanks.evaluate_tanks`, the others through
+:func:`evaluate.sim_evaluate` with the entry's scenario (1v1 or 4v4). Both sides of a seed face the same
+TD-team artefact (the PPO run's), each at its own step length. Per entry and method: the mean share over seeds
+and ``PPO tanks - method`` paired over seeds (BCa interval, one-sided sign-flip permutation p).
+
+Writes ``compare.json`` and ``compare.md`` into ``--out``. Trained baselines and per-(method, seed) results are
+cached under ``--work`` (default ``runs/tank-compare``), so an interrupted comparison resumes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from confront import checkpoint as ck
+from confront.arena.bots import BOT_NAMES
+from confront.experiments.baselines import (
+    DMNN_METHOD,
+    RANDOM_METHOD,
+    BaselinesConfig,
+    SB3Policy,
+    baseline_experiment,
+    train_sb3,
+)
+from confront.experiments.evaluate import sim_evaluate
+from confront.experiments.reproduce import Job, run_jobs
+from confront.experiments.spec import ExperimentConfig, config_from_dict, load_toml
+from confront.experiments.stats import paired_comparison
+from confront.experiments.tanks import evaluate_tanks, load_tank_model
+from confront.learning.base import Learner
+
+__all__ = ["OURS", "METHODS", "compare_entries", "method_shares", "compare", "write_markdown"]
+
+OURS = "PPO tanks"
+SB3_PPO = "PPO (SB3)"
+METHODS = (DMNN_METHOD, SB3_PPO, RANDOM_METHOD)
+TRAIN_ROUNDS = 500  # the baselines' budget (the paper's)
+
+
+def compare_entries(opponents: tuple[str, ...]) -> list[str]:
+    """The league entries every method can play: a sample robot (1v1 or as a team) or the TD team."""
+    out = []
+    for e in opponents:
+        scen, _, opp = e.partition(":")
+        if scen in ("1v1", "4v4") and (opp in BOT_NAMES or (opp == "td" and scen == "4v4")):
+            out.append(e)
+    return out
+
+
+def _share(rows: list[dict[str, Any]]) -> float:
+    o = sum(float(r["score_ours"]) for r in rows)
+    t = sum(float(r["score_theirs"]) for r in rows)
+    return o / (o + t) if o + t > 0 else 0.5
+
+
+def _baseline_policy(method: str, seed: int, work: Path) -> tuple[Learner, ExperimentConfig]:
+    """The trained (or, for random moves, built) policy of ``method`` at ``seed``, and its experiment config."""
+    from confront.experiments.train import load_model, smdp_config
+    from confront.learning.uniform import UniformParams, UniformPolicy
+
+    bcfg = BaselinesConfig()
+    exp = baseline_experiment(bcfg, seed, TRAIN_ROUNDS)
+    if method == RANDOM_METHOD:
+        return UniformPolicy(UniformParams(n_actions=smdp_config(exp).n_actions)), exp
+    if method == DMNN_METHOD:
+        folder = work / "runs" / "dmnn-flm" / f"seed-{seed}"
+        run_jobs([Job("tank-compare", DMNN_METHOD, seed, bcfg.base,
+                      bcfg.overrides + ('learner.learning_rate="fuzzy"',), folder)], TRAIN_ROUNDS, 1)
+        learner, _ = load_model(folder)
+        return learner, exp
+    if method == SB3_PPO:
+        model, info = train_sb3("PPO", bcfg, seed, TRAIN_ROUNDS)
+        policy = SB3Policy(model, int(model.action_space.n))
+        folder = work / "sb3-ppo" / f"seed-{seed}"
+        folder.mkdir(parents=True, exist_ok=True)
+        buf = io.BytesIO()
+        np.savez(buf, **policy.state_dict())
+        ck.write_atomic(folder / "policy.npz", buf.getvalue())
+        ck.write_atomic(folder / "train.json", json.dumps(info, indent=1).encode())
+        return policy, exp
+    raise ValueError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+
+
+def method_shares(method: str, seed: int, entries: list[str], td_model: str, rounds: int, work: Path
+                  ) -> dict[str, float]:
+    """Greedy share per entry of a baseline method at ``seed`` (cached in ``work``)."""
+    done = work / "results" / f"{method.replace(' ', '_').replace('(', '').replace(')', '')}-seed-{seed}.json"
+    if done.exists():
+        cached = json.loads(done.read_text())
+        if cached.get("rounds") == rounds and all(e in cached["shares"] for e in entries):
+            return {e: cached["shares"][e] for e in entries}
+    policy, exp = _baseline_policy(method, seed, work)
+    shares = {}
+    for e in entries:
+        scen, _, opp = e.partition(":")
+        cfg = replace(exp, arena=replace(exp.arena, scenario=scen))
+        rows = sim_evaluate(cfg, policy, opp, rounds, 10_000 + seed, td_model if opp == "td" else None)
+        shares[e] = _share(rows)
+    done.parent.mkdir(parents=True, exist_ok=True)
+    ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "shares": shares},
+                                     indent=1).encode())
+    return shares
+
+
+def compare(runs: list[Path], out: Path, rounds: int, work: Path) -> dict[str, Any]:
+    """Evaluate PPO tanks and every baseline method per seed and entry; write the report; return the results."""
+    from confront.experiments.train import td_team
+
+    cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
+    seeds = [c.train.seed for c in cfgs]
+    if len(set(seeds)) != len(seeds):
+        raise ValueError(f"the runs must have distinct training seeds, got {seeds}")
+    entries = compare_entries(tuple(cfgs[0].league.opponents))
+    shares: dict[str, dict[str, list[float]]] = {m: {e: [] for e in entries} for m in (OURS, *METHODS)}
+    for run, cfg in zip(runs, cfgs, strict=True):
+        _, td_path = td_team(cfg, 4)
+        ours = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000 + cfg.train.seed,
+                              opponents=tuple(entries))
+        for e in entries:
+            shares[OURS][e].append(ours[e]["share"])
+        for m in METHODS:
+            got = method_shares(m, cfg.train.seed, entries, str(td_path), rounds, work)
+            for e in entries:
+                shares[m][e].append(got[e])
+    rng = np.random.default_rng(2026)
+    tests = {m: {} for m in METHODS}
+    for m in METHODS:
+        for e in entries:
+            pc = paired_comparison(np.array(shares[OURS][e]), np.array(shares[m][e]), rng)
+            tests[m][e] = {"diff": pc.diff.mean, "lo": pc.diff.lo, "hi": pc.diff.hi, "p": pc.p}
+    result = {"runs": [str(r) for r in runs], "seeds": seeds, "rounds": rounds, "train_rounds": TRAIN_ROUNDS,
+              "entries": entries, "shares": shares, "tests": tests}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "compare.json").write_text(json.dumps(result, indent=1))
+    write_markdown(result, out)
+    return result
+
+
+def write_markdown(result: dict[str, Any], out: Path) -> Path:
+    """``compare.md`` from ``compare.json``'s content."""
+    seeds, entries, shares, tests = result["seeds"], result["entries"], result["shares"], result["tests"]
+    n = len(seeds)
+    lines = [
+        "# PPO tanks against the paper's method, SB3 PPO and random moves",
+        "",
+        f"Training seeds {', '.join(map(str, seeds))} (one PPO tanks run each; the baselines trained "
+        f"{result['train_rounds']} rounds against the same seed's TD team, as `confront reproduce baselines`). "
+        f"Simulator, greedy, {result['rounds']} rounds per entry and seed (battle seed 10000 + seed).",
+        f"Cells: mean share over the {n} seeds; `vs X`: PPO tanks - X, mean [95% BCa interval], one-sided paired "
+        "sign-flip permutation p (the smallest possible p with n seeds is 2^-n).",
+        "",
+        "| entry | " + " | ".join([OURS, *METHODS]) + " | " + " | ".join(f"vs {m}" for m in METHODS) + " |",
+        "|---|" + "---:|" * (1 + len(METHODS)) + ":---|" * len(METHODS),
+    ]
+    beats = {m: 0 for m in METHODS}
+    for e in entries:
+        cells = [f"{np.mean(shares[k][e]):.3f}" for k in (OURS, *METHODS)]
+        vs = []
+        for m in METHODS:
+            t = tests[m][e]
+            beats[m] += t["p"] < 0.05 and t["diff"] > 0
+            vs.append(f"{t['diff']:+.3f} [{t['lo']:+.3f}, {t['hi']:+.3f}] p={t['p']:.3g}")
+        lines.append(f"| {e} | " + " | ".join(cells) + " | " + " | ".join(vs) + " |")
+    lines += ["", "PPO tanks ahead at p < 0.05: " + "; ".join(f"{m} on {beats[m]} of {len(entries)} entries"
+                                                          for m in METHODS) + ".", ""]
+    path = out / "compare.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="+", type=Path)
+    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--rounds", type=int, default=100)
+    ap.add_argument("--work", type=Path, default=Path("runs") / "tank-compare")
+    args = ap.parse_args()
+    if args.rounds < 1:
+        ap.error("--rounds must be at least 1")
+    for r in args.runs:
+        if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
+            ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")
+    compare(args.runs, args.out, args.rounds, args.work)
+    print((args.out / "compare.md").read_text())
+
+
+if __name__ == "__main__":
+    main()

@@ -75,12 +75,16 @@ def cli() -> None:
 @click.option("--rounds", type=COUNT, default=None, help="Rounds to train (default from the demo config).")
 @click.option("--seed", type=SEED, default=None)
 @click.option("--paper", is_flag=True, help="Train the paper's 4v4 fuzzy DMNN arm instead (config demo).")
+@click.option("--contrast", is_flag=True, help="Also train the paper's arm and plot both against the TD team.")
 @set_option
-def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, overrides: tuple[str, ...]) -> None:
+def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, contrast: bool,
+         overrides: tuple[str, ...]) -> None:
     """Train PPO tanks against the TD team, a dodging team and sample robots, then print and plot the results."""
     from confront.experiments.demo import run_demo
 
-    run_demo(out=out, rounds=rounds, seed=seed, overrides=overrides, paper=paper)
+    if paper and contrast:
+        raise click.UsageError("--contrast trains both arms; leave out --paper")
+    run_demo(out=out, rounds=rounds, seed=seed, overrides=overrides, paper=paper, contrast=contrast)
 
 
 @cli.command()

@@ -1,19 +1,22 @@
 """``confront demo``: the main job in small — PPO tanks learn to beat the TD team, a dodging team and sample
-robots (config ``tanks-demo``); ``--paper`` trains the paper's 4v4 fuzzy DMNN arm instead (config ``demo``)."""
+robots (config ``tanks-demo``); ``--paper`` trains the paper's 4v4 fuzzy DMNN arm instead (config ``demo``);
+``--contrast`` trains both and draws their score share against the same TD team in one figure."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import click
+import numpy as np
 
 from confront.experiments.spec import load_experiment
 from confront.runs import new_run_name
 
 
 def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | None = None,
-             overrides: tuple[str, ...] = (), paper: bool = False) -> dict:
-    """Train the demo config, print the score table, write plots; return the summary."""
+             overrides: tuple[str, ...] = (), paper: bool = False, contrast: bool = False) -> dict:
+    """Train the demo config, print the score table, write plots; return the summary (with ``contrast``, also
+    the paper's arm into ``<out>/paper-arm`` and ``plots/contrast.png``)."""
     from confront.experiments.train import print_summary, train_run
 
     extra = list(overrides)
@@ -32,6 +35,14 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
     click.echo(f"confront demo: {cfg.description}")
     summary = train_run(cfg, out, progress=True)
     print_summary(summary)
+    if contrast and not paper:
+        arm = load_experiment("demo", () if seed is None else (f"train.seed={seed}",))
+        click.echo(f"\nfor contrast, the paper's arm: {arm.description}")
+        paper_summary = train_run(arm, out / "paper-arm", progress=True)
+        print_summary(paper_summary)
+        fig = plot_contrast(out, out / "paper-arm")
+        summary["figures"] = [*summary.get("figures", []), str(fig)]
+        click.echo(f"\ncontrast figure: {fig}")
     click.echo(
         "\nNext:\n"
         f"  open {out}/plots/*.png                    the learning curves\n"
@@ -42,3 +53,45 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
         "  confront demo --paper                      the paper's fuzzy DMNN arm, for contrast\n"
     )
     return summary
+
+
+def _windows(rows: list[dict], size: int) -> tuple[np.ndarray, np.ndarray]:
+    """(rounds so far, pooled score share) per window of ``size`` rounds."""
+    x, y = [], []
+    for i in range(0, len(rows) - size + 1, size):
+        chunk = rows[i:i + size]
+        o = sum(float(r["score_ours"]) for r in chunk)
+        t = sum(float(r["score_theirs"]) for r in chunk)
+        x.append(i + size)
+        y.append(o / (o + t) if o + t else 0.5)
+    return np.asarray(x), np.asarray(y)
+
+
+def plot_contrast(tanks_run: Path, paper_run: Path) -> Path:
+    """Score share against the 4v4 TD team per window of rounds: PPO tanks (their ``4v4:td`` rounds) and the
+    paper's arm (all its rounds are against the TD team), each against its own rounds played."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from confront.runs import Run
+
+    ours = [r for r in Run(tanks_run).read_table("rounds") if r["opponent"] == "4v4:td"]
+    theirs = Run(paper_run).read_table("rounds")
+    fig, ax = plt.subplots(figsize=(7, 4), dpi=110)
+    for rows, label in ((ours, "PPO tanks (recommended)"), (theirs, "paper's DMNN (FLM, AWM)")):
+        x, y = _windows(rows, max(10, len(rows) // 20))
+        ax.plot(x, y, lw=1.6, marker="o", ms=3, label=f"{label}, {len(rows)} rounds")
+    ax.axhline(0.5, color="k", lw=0.8, ls=":")
+    ax.set_xlabel("rounds played against the 4v4 TD team")
+    ax.set_ylabel("score share (training)")
+    ax.set_title("The same TD team: PPO tanks against the paper's arm")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path = Path(tanks_run) / "plots" / "contrast.png"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+    return path

@@ -146,6 +146,20 @@ def test_compare_entries_and_paired_verdicts(tmp_path) -> None:
     assert f"{METHODS[0]} on 1 of 2 entries" in md
 
 
+def test_demo_contrast_windows_and_figure(tmp_path) -> None:
+    from confront.experiments.demo import _windows, plot_contrast
+
+    rows = [{"opponent": "4v4:td", "score_ours": 3.0 * (k >= 10), "score_theirs": 1.0} for k in range(20)]
+    x, y = _windows(rows, 10)
+    np.testing.assert_array_equal(x, [10, 20])
+    np.testing.assert_allclose(y, [0.0, 0.75])
+    Run(tmp_path / "tanks").write_table("rounds", rows + [{"opponent": "1v1:SpinBot", "score_ours": 9.0,
+                                                          "score_theirs": 0.0}])
+    Run(tmp_path / "paper").write_table("rounds", [{"score_ours": 1.0, "score_theirs": 1.0}] * 30)
+    fig = plot_contrast(tmp_path / "tanks", tmp_path / "paper")
+    assert fig == tmp_path / "tanks" / "plots" / "contrast.png" and fig.stat().st_size > 5000
+
+
 @pytest.mark.parametrize(("override", "message"), [
     ('league.opponents=["1v1:nope"]', "league.opponents entry '1v1:nope'"),
     ('tank.leads=["sideways"]', "tank.leads entry 'sideways'"),

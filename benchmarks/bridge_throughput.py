@@ -10,14 +10,22 @@ constant everywhere) four modes, interleaved and repeated (the order rotates eac
   turn by turn when no turn is skipped (the benchmark checks the turn counts);
 - ``bridge T lead``: the same, but each observation leaves ``--lead`` turns before its decision turn, so the
   policy runs while the engine plays on (decisions rest on a state that many turns old: a different battle);
-- ``bridge 1``: the Python twin decides every turn, gun and radar included (no controller in Java).
+- ``bridge 1``: the Python twin decides every turn, gun and radar included (no controller in Java);
+- ``acting T``: the robots play the same Q table themselves (``run_bridged_battle(acting=...)``: their own copy
+  of the policy, first maximum as PolicyBot) and send each observation with the move taken; Python takes it in
+  (the twin checks the move: ``mismatches``) and acknowledges it, and a robot waits only when ``--max-lag``
+  observations are unacknowledged: again the same battle as ``java``;
+- ``learn T`` / ``learn T acting``: a learning SSAQ tank (``LearnerPolicy`` around a fresh ``TabularQ``,
+  Boltzmann exploration, each SMDP step learned at once), deciding in Python (one round trip per decision) or
+  acting from its own copy of the Q table that every update reaches (``LearnerPolicy.bridge_kwargs()``);
+  learning changes the battle, so its turns differ from ``java``'s.
 T is the configs' ``arena.decision_turns`` (10). Bridge cost = 1 - bridged turns/s / reference turns/s,
 per repetition (neighbouring runs, similar machine load), excluding the round-start wait; the wait is
 reported on its own. "excl. policy" also leaves out the time spent inside the Python policy itself (what a
 Java policy would cost instead is in the ``java`` row). Goal of issue 5: cost <= 25%.
 
-Usage: python benchmarks/bridge_throughput.py [--rounds 10] [--repeats 3] [--cpu-ms 30] [--lead 5]
-       [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--json FILE]
+Usage: python benchmarks/bridge_throughput.py [--rounds 10] [--repeats 3] [--cpu-ms 100] [--lead 5]
+       [--max-lag 1] [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--json FILE]
 """
 
 from __future__ import annotations
@@ -37,12 +45,15 @@ import numpy as np
 from confront.engine.battle import BattleSpec, Team
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
+from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 from confront.experiments.spec import ArenaSection
+from confront.learning.tabular import TabularQ
 
 OPPONENTS = ("Walls", "Tracker", "SpinBot", "RamFire")
 STAND_IN = "Tracker"  # the sample robot that takes our place in the sample-only battle
-MODES = ("sample", "java", "bridge T", "bridge T lead", "bridge 1")
+MODES = ("sample", "java", "bridge T", "bridge T lead", "bridge 1", "acting T", "learn T", "learn T acting")
+BRIDGED = MODES[2:]
 
 
 def _spec(size: int, ours: str, rounds: int) -> BattleSpec:
@@ -64,11 +75,23 @@ def _record(battle: str, mode: str, rep: int, run: EngineRun, wall: float, br: B
         "rtt_mean_us": br.rtt_mean_us if br else None, "rtt_over_1ms": br.rtt_over_1ms if br else None,
         "policy_us": br.policy_us if br else None, "handling_us": br.handling_us if br else None,
         "work_us_per_turn": br.work_us_per_turn if br else None,
+        "mismatches": None, "behind": br.behind if br else None,
     }
 
 
+class _Checked:
+    """The twin as the policy of robots that act themselves: counts the moves it would not have taken."""
+
+    def __init__(self, policy: ExportedPolicy) -> None:
+        self.policy, self.mismatches = policy, 0
+
+    def __call__(self, obs):  # noqa: ANN001, ANN204 - a bridge policy
+        self.mismatches += self.policy.act(obs) != obs.action
+        return self.policy(obs)
+
+
 def _runner(mode: str, size: int, rounds: int, opts: EngineOptions, policy: ExportedPolicy, exported: Path,
-            every: int, lead: int) -> Callable[[], tuple[EngineRun, BridgedRun | None]]:
+            every: int, lead: int, max_lag: int, seed: int) -> Callable[[], tuple[EngineRun, BridgedRun | None]]:
     def run() -> tuple[EngineRun, BridgedRun | None]:
         if mode == "sample":
             return run_battle(_spec(size, STAND_IN, rounds), opts), None
@@ -77,9 +100,19 @@ def _runner(mode: str, size: int, rounds: int, opts: EngineOptions, policy: Expo
         if mode in ("bridge T", "bridge T lead"):
             br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), policy, opts, every=every,
                                     controller=policy.control, lead=lead if mode == "bridge T lead" else 0)
+        elif mode == "acting T":
+            checked = _Checked(policy)
+            br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), checked, opts, every=every,
+                                    controller=policy.control, acting=policy.robot_acting(max_lag))
+            run.mismatches = checked.mismatches  # type: ignore[attr-defined]
+        elif mode in ("learn T", "learn T acting"):
+            learner = LearnerPolicy(TabularQ(), np.random.default_rng(seed), train=True, step_turns=every,
+                                    acting=mode == "learn T acting", max_lag=max_lag)
+            br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), learner, opts, **learner.bridge_kwargs())
         else:
             br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), policy, opts, every=1)
         return br.run, br
+    run.mismatches = None  # type: ignore[attr-defined]
     return run
 
 
@@ -112,7 +145,7 @@ def report(records: list[dict[str, Any]]) -> None:
                   f"{_mean(rs, 'policy_us')} | {_mean(rs, 'handling_us')} | {_mean(rs, 'work_us_per_turn')}")
     print("\nbridge cost = 1 - bridged/reference turns/s excl. set-up, per repetition: median (range); goal <= 25%")
     for battle in dict.fromkeys(r["battle"] for r in records):
-        for mode in ("bridge T", "bridge T lead", "bridge 1"):
+        for mode in BRIDGED:
             for ref in ("sample", "java"):
                 for key, label in (("turns_per_s_excl_setup", ""), ("turns_per_s_excl_policy", ", excl. policy")):
                     costs = []
@@ -129,6 +162,10 @@ def report(records: list[dict[str, Any]]) -> None:
                 if j["battle"] == b["battle"] == battle and j["repeat"] == b["repeat"]
                 and (j["mode"], b["mode"]) == ("java", "bridge T")]
         print(f"{battle}: turns java vs bridge T per repetition {same} (equal = the same battle)")
+        same = [(j["turns"], b["turns"]) for j in records for b in records
+                if j["battle"] == b["battle"] == battle and j["repeat"] == b["repeat"]
+                and (j["mode"], b["mode"]) == ("java", "acting T")]
+        print(f"{battle}: turns java vs acting T per repetition {same} (equal = the same battle)")
 
 
 def check_skipped(rounds: int, every: int, cpu_ms: float, seed: int, policy: ExportedPolicy) -> dict[str, Any]:
@@ -153,6 +190,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--every", type=int, default=ArenaSection().decision_turns, help="T: turns per decision")
     ap.add_argument("--lead", type=int, default=5, help="turns ahead for the 'bridge T lead' mode")
+    ap.add_argument("--max-lag", type=int, default=1, help="unacknowledged observations before an acting robot waits")
     ap.add_argument("--battles", default="1v1,4v4")
     ap.add_argument("--modes", default=",".join(MODES))
     ap.add_argument("--check-rounds", type=int, default=0, help="also a bridged 1v1 of this many rounds")
@@ -176,13 +214,17 @@ def main() -> None:
             for battle in battles:
                 for mode in order:
                     t0 = time.perf_counter()
-                    run, br = _runner(mode, sizes[battle], args.rounds, opts, policy, exported, args.every,
-                                      args.lead)()
+                    runner = _runner(mode, sizes[battle], args.rounds, opts, policy, exported, args.every,
+                                     args.lead, args.max_lag, args.seed + rep)
+                    run, br = runner()
                     rec = _record(battle, mode, rep, run, time.perf_counter() - t0, br)
+                    rec["mismatches"] = runner.mismatches  # type: ignore[attr-defined]
                     records.append(rec)
                     print(f"  [{rep}] {battle} {mode}: {rec['turns']} turns, {rec['turns_per_s_excl_setup']:.0f} "
-                          f"turns/s excl. set-up ({rec['setup_s']:.2f} s set-up), load {os.getloadavg()[0]:.1f}",
-                          flush=True)
+                          f"turns/s excl. set-up ({rec['setup_s']:.2f} s set-up), "
+                          f"held up {rec['rtt_mean_us'] or 0:.0f} us/decision, "
+                          f"{rec['skipped_turns']} skipped, mismatches {rec['mismatches']}, behind {rec['behind']}, "
+                          f"load {os.getloadavg()[0]:.1f}", flush=True)
         report(records)
         if args.check_rounds:
             records.append(check_skipped(args.check_rounds, args.every, args.cpu_ms, args.seed, policy))

@@ -9,16 +9,25 @@ Protocol v2, one line per message (UTF-8). Robot -> Python:
   by "|", each ``NAME;TIME;TEAMMATE(0/1);BEARING;DISTANCE;HEADING;VELOCITY;ENERGY;X;Y``; EVENTS a JSON list
   of the events since the last observation; HISTORY (empty unless asked for) one
   ``TIME;ENERGY;TARGET;TARGET_PREVIOUS;TARGET_ENERGY`` record per turn since the last observation, joined by
-  "|" (:class:`TurnEnergy`); TURN is the engine turn the answer takes effect in;
+  "|" (:class:`TurnEnergy`); TURN is the engine turn the answer takes effect in; when the robot acts on its own
+  (ACTING below) a fifth field<TAB>MOVE;BEHIND carries the move (0-3) it took in that turn and how many of its
+  observations were still unacknowledged when it chose it (0: its copy had every update up to its last
+  observation), and nothing is answered;
 - ``E ROUND TIME HOW ENERGY DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US<TAB>HISTORY`` at death or
   round end: the round's decisions, the time the robot was held up by their round trips and how many took
   over 1 ms, the turns played and the robot's own time outside ``execute()`` (deciding and the controller),
   and the history records since the last observation.
-Python -> robot: ``OK 2 EVERY LEAD HISTORY(0/1) N`` after a valid hello (:class:`BridgeSettings`), followed
+Python -> robot: ``OK 2 EVERY LEAD HISTORY(0/1) N [M]`` after a valid hello (:class:`BridgeSettings`), followed
 by N ``key value`` lines: the parameters of the fixed gun/radar controller
 (:class:`~confront.arena.control.ControlConfig`) that the robot then runs in Java every turn (N = 0: no
-controller, the answers' gun, radar and fire are used); ``A TURN AHEAD TURN GUN RADAR FIRE`` per
-observation (radians, + clockwise; ``NaN`` keeps the remaining value; fire 0 = no shot). Between decisions
+controller, the answers' gun, radar and fire are used); then, when M is given, M lines: ``acting EXPLORE
+PARAM SEED MAX_LAG`` and the policy file of the robot's own copy of the policy (PolicyModel's, e.g. the
+learner's current Q table), with which the robot then picks its moves itself (:class:`RobotActing`).
+``A TURN AHEAD TURN GUN RADAR FIRE`` per observation when Python decides (radians, + clockwise; ``NaN`` keeps
+the remaining value; fire 0 = no shot). When the robot acts: ``K TURN`` acknowledges its observation of TURN
+once the policy has taken it in (the robot stops and waits, at most its timeout, when MAX_LAG observations
+are unacknowledged), and at any time, to every acting robot of the battle, ``Q STATE V0 V1 V2 V3`` (a row of
+the Q table changed) and ``X PARAM`` (the exploration parameter changed). Between decisions
 the robot's commands keep running (remaining distance and turns) with no round trip. A compact text line
 instead of JSON keeps the cost low (measured: docs/engine.md). A robot whose Python side fails (no answer
 within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the round and
@@ -114,6 +123,8 @@ class Observation:
     scans: tuple[Scan, ...] = ()
     events: tuple[dict[str, Any], ...] = ()
     history: tuple[TurnEnergy, ...] = ()  # with BridgeSettings.history: each turn since the last observation
+    action: int = -1  # the move the robot took itself (BridgeSettings.acting); -1: the policy decides
+    behind: int = 0  # acting: the robot's observations not yet acknowledged when it chose that move
 
     def enemies(self) -> tuple[Scan, ...]:
         """Scans of robots that are not team-mates."""
@@ -122,6 +133,46 @@ class Observation:
 
 Action = Sequence[float]
 Policy = Callable[[Observation], Action]
+
+
+EXPLORE_KINDS = ("first", "greedy", "boltzmann", "egreedy")
+
+
+@dataclass(frozen=True)
+class RobotActing:
+    """The robots pick their moves themselves from their own copy of the policy; Python only learns.
+
+    ``model()``: the current policy file (PolicyModel's format: ``ExportedPolicy.to_text()``), sent in each
+    hello reply (a new robot object every round gets the policy as it is then). ``explore``: how the robot picks
+    from the move values: ``first`` (the first maximum, as the exported robot), ``greedy`` (a maximum, ties at
+    random), ``boltzmann`` (softmax at temperature ``param()``), ``egreedy`` (greedy with probability
+    ``param()``, else uniform). ``seed()``: the robot's random generator per connection. ``updates()``: the
+    lines (``Q STATE V0 V1 V2 V3``, ``X PARAM``) that bring every connected robot's copy up to date, drained
+    after each message the policy took in. ``max_lag``: a robot waits (at most its timeout) when this many of its
+    observations are not yet acknowledged, so its copy is never more than ``max_lag`` observations behind.
+    """
+
+    model: Callable[[], str]
+    explore: str = "first"
+    param: Callable[[], float] = lambda: 0.0
+    seed: Callable[[], int] = lambda: 0
+    updates: Callable[[], list[str]] = list
+    max_lag: int = 4
+
+    def __post_init__(self) -> None:
+        if self.explore not in EXPLORE_KINDS:
+            raise ValueError(f"explore must be one of {EXPLORE_KINDS}, got {self.explore!r}")
+        if not 1 <= self.max_lag <= 1000:
+            raise ValueError(f"max_lag must be in [1, 1000], got {self.max_lag}")
+
+    def hello_lines(self) -> list[str]:
+        """``acting EXPLORE PARAM SEED MAX_LAG`` and the policy file's lines."""
+        param = float(self.param())
+        if not (param > 0 if self.explore == "boltzmann" else 0 <= param <= 1) or not math.isfinite(param):
+            raise ValueError(f"exploration parameter must be finite and a temperature > 0 (boltzmann) or a "
+                             f"threshold in [0, 1], got {param} for {self.explore}")
+        seed = int(self.seed()) & ((1 << 63) - 1)
+        return [f"acting {self.explore} {param!r} {seed} {self.max_lag}", *self.model().splitlines()]
 
 
 @dataclass(frozen=True)
@@ -138,24 +189,35 @@ class BridgeSettings:
     this many turns before its decision turn and read the answer in that turn, so the policy runs while the
     engine plays on (the decision then rests on a state ``lead`` turns old; the first of a round is taken in
     turn 1 as usual); 0 = ask and wait in the decision turn (what the exported robot and the simulator do).
+    ``acting``: the robots pick their moves from their own copy of the policy and never wait for an answer
+    (:class:`RobotActing`; needs the controller, no lead): the engine then runs at the exported robot's speed
+    while Python learns from the observations, at the price of a copy that lags the learner by up to
+    ``max_lag`` observations.
     """
 
     every: int = 1
     controller: ControlConfig | None = None
     history: bool = False
     lead: int = 0
+    acting: RobotActing | None = None
 
     def __post_init__(self) -> None:
         if self.every < 1:
             raise ValueError(f"every must be >= 1, got {self.every}")
         if not 0 <= self.lead < self.every:
             raise ValueError(f"lead must be in [0, every) = [0, {self.every}), got {self.lead}")
+        if self.acting is not None and (self.controller is None or self.lead):
+            raise ValueError("robots that act themselves need the controller in Java and no lead")
 
     def hello_reply(self) -> str:
-        """``OK 2 EVERY LEAD HISTORY N`` and the controller's N ``key value`` lines (the policy file's)."""
+        """``OK 2 EVERY LEAD HISTORY N``, the controller's N ``key value`` lines (the policy file's); for robots
+        that act themselves ``OK 2 EVERY LEAD HISTORY N M`` and after those the M lines of the robot's own policy
+        (:meth:`RobotActing.hello_lines`)."""
         lines = controller_lines(self.controller) if self.controller is not None else []
+        acting = self.acting.hello_lines() if self.acting is not None else []
         first = f"OK {PROTOCOL_VERSION} {self.every} {self.lead} {int(self.history)} {len(lines)}"
-        return "".join(line + "\n" for line in [first, *lines])
+        first += f" {len(acting)}" if acting else ""
+        return "".join(line + "\n" for line in [first, *lines, *acting])
 
 
 def controller_lines(control: ControlConfig) -> list[str]:
@@ -222,12 +284,19 @@ def _floats(texts: Sequence[str], what: str) -> list[float]:
     return vals
 
 
-def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
-    """Validate one ``O ...`` line (from the robot introduced by ``hello``) into an :class:`Observation`."""
+def parse_observation(line: str, hello: dict[str, Any], acting: bool = False) -> Observation:
+    """Validate one ``O ...`` line (from the robot introduced by ``hello``) into an :class:`Observation`;
+    ``acting``: the line must end with the move the robot took (0-3) and how far its copy was behind."""
     parts = line.split("\t")
     head = parts[0].split(" ")
-    if len(parts) != 4 or head[0] != "O" or len(head) != _OBS_FIELDS:
+    if len(parts) != 4 + acting or head[0] != "O" or len(head) != _OBS_FIELDS:
         raise ValueError(f"bad observation line: {line[:80]!r}")
+    action, behind = -1, 0
+    if acting:
+        move = parts[4].split(";")
+        action, behind = int(move[0]), int(move[-1])
+        if len(move) != 2 or not 0 <= action < 4 or not 0 <= behind <= 1000:
+            raise ValueError(f"bad move field {parts[4][:40]!r}: MOVE (0-3);BEHIND (0-1000)")
     rnd, turn, others = int(head[1]), int(head[2]), int(head[11])
     if rnd != hello["round"] or turn < 0 or others < 0:
         raise ValueError(f"observation of round {rnd}, turn {turn}, others {others} on the connection of round "
@@ -251,7 +320,7 @@ def parse_observation(line: str, hello: dict[str, Any]) -> Observation:
         robot=hello["name"], teammates=team, round=rnd, turn=turn, x=x, y=y, heading=heading,
         gun_heading=gun, radar_heading=radar, velocity=vel, energy=energy, gun_heat=heat, others=others,
         distance_remaining=remaining, width=float(hello["width"]), height=float(hello["height"]),
-        scans=tuple(scans), events=events, history=parse_history(parts[3]),
+        scans=tuple(scans), events=events, history=parse_history(parts[3]), action=action, behind=behind,
     )
 
 
@@ -279,7 +348,7 @@ def format_observation(obs: Observation) -> str:
     history = "|".join(f"{h.time};{h.energy!r};{h.target};{h.target_previous!r};{h.target_energy!r}"
                        for h in obs.history)
     return ("O " + " ".join(repr(v) for v in head) + "\t" + scans + "\t" + json.dumps(list(obs.events)) + "\t"
-            + history)
+            + history + ("" if obs.action < 0 else f"\t{obs.action};{obs.behind}"))
 
 
 def format_action(turn: int, action: Action) -> str:
@@ -327,8 +396,11 @@ class BridgeStats:
     errors_dropped: int = 0
     resets: int = 0  # sessions the robot's side reset: the engine stops robot threads at a round's end
     rejected: dict[str, int] = field(default_factory=dict)
+    behind: int = 0  # acting robots: decisions taken while some of the robot's own observations were unacknowledged
     policy_s: float = 0.0  # time inside the policy
     handling_s: float = 0.0  # the server's own time per decision: parse, format, send (policy excluded)
+    parse_s: float = 0.0  # of which parsing the observation
+    send_s: float = 0.0  # of which sending the answer
     # as the robots measured them (sums over the rounds they ended while connected)
     robot_decisions: int = 0
     rtt_total_us: int = 0
@@ -402,6 +474,7 @@ class BridgeServer:
         self._stop = threading.Event()
         self._lock = threading.Lock()
         self._conns: set[socket.socket] = set()
+        self._acting: dict[socket.socket, str] = {}  # robots that act themselves: their update streams
         self._thread: threading.Thread | None = None
 
     def start(self) -> BridgeServer:
@@ -526,10 +599,34 @@ class BridgeServer:
 
     def _error(self, text: str) -> None:
         with self._lock:
-            if len(self.stats.errors) < MAX_ERRORS:
-                self.stats.errors.append(text[:500])
-            else:
-                self.stats.errors_dropped += 1
+            self._error_locked(text)
+
+    def _error_locked(self, text: str) -> None:
+        if len(self.stats.errors) < MAX_ERRORS:
+            self.stats.errors.append(text[:500])
+        else:
+            self.stats.errors_dropped += 1
+
+    def _broadcast(self, lines: list[str], owner: socket.socket | None, ack: str) -> None:
+        """Send update ``lines`` to every acting robot and ``ack`` to ``owner`` (lock held). Never blocks: a
+        robot whose buffer is full (it stopped reading) is cut off, and its robot falls back."""
+        text = "".join(line + "\n" for line in lines)
+        for sock, name in list(self._acting.items()):
+            data = (text + ack if sock is owner else text).encode()
+            if not data:
+                continue
+            try:
+                if sock.send(data, socket.MSG_DONTWAIT) == len(data):
+                    continue
+            except BlockingIOError:
+                pass
+            except OSError:  # the robot closed its end (its round is over): its own session ends it
+                del self._acting[sock]
+                continue
+            del self._acting[sock]  # its buffer is full: it stopped reading, so its copy cannot be kept current
+            self._error_locked(f"{name}: stopped reading its policy updates; connection closed")
+            with contextlib.suppress(OSError):
+                sock.shutdown(socket.SHUT_RDWR)
 
     def _serve(self, sock: socket.socket, hello: dict[str, Any], rest: bytes) -> None:
         """One robot's session after a valid hello: observations answered, one end line, then the socket closes."""
@@ -539,7 +636,13 @@ class BridgeServer:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             if self.on_hello is not None:
                 self.on_hello(hello)
-            sock.sendall(self._reply)
+            acting = self.settings.acting
+            if acting is None:
+                sock.sendall(self._reply)
+            else:
+                with self._lock:  # the policy as it is now, and from now on every update to it
+                    sock.sendall(self.settings.hello_reply().encode())
+                    self._acting[sock] = hello["name"]
             sock.settimeout(None)
             lines = LineReader(sock, MAX_LINE, rest)
             while (line := lines.readline()) is not None:
@@ -549,6 +652,7 @@ class BridgeServer:
                     ended = True
                     rnd, numbers, history = parse_end(line, hello)
                     with self._lock:
+                        self._acting.pop(sock, None)
                         self.stats.rounds_ended += 1
                         self.stats.add_round_end(numbers)
                         end = getattr(self.policy, "end_episode", None)
@@ -556,19 +660,30 @@ class BridgeServer:
                             end(hello["name"], rnd, history)
                         elif end is not None:  # e.g. a learner's last SMDP step of the round
                             end(hello["name"], rnd)
+                        if acting is not None:
+                            self._broadcast(acting.updates(), None, "")
                 else:
                     if ended:
                         raise ValueError("an observation after the end line")
                     t0 = time.perf_counter()
-                    obs = parse_observation(line, hello)
+                    obs = parse_observation(line, hello, acting is not None)
                     parsed = time.perf_counter()
                     with self._lock:  # waiting here (team-mates' decisions) is counted nowhere
                         t1 = time.perf_counter()
                         action = self.policy(obs)
                         t2 = time.perf_counter()
-                    sock.sendall(format_action(obs.turn, action).encode())
-                    t3 = time.perf_counter()
+                        if acting is not None:  # the robot has moved already: bring every copy up to date
+                            self._broadcast(acting.updates(), sock, f"K {obs.turn}\n")
+                    t25 = t3 = time.perf_counter()
+                    if acting is None:
+                        data = format_action(obs.turn, action).encode()
+                        t25 = time.perf_counter()
+                        sock.sendall(data)
+                        t3 = time.perf_counter()
                     with self._lock:
+                        self.stats.behind += obs.behind > 0
+                        self.stats.parse_s += parsed - t0
+                        self.stats.send_s += t3 - t25
                         self.stats.decisions += 1
                         self.stats.policy_s += t2 - t1
                         self.stats.handling_s += (parsed - t0) + (t3 - t2)
@@ -583,6 +698,7 @@ class BridgeServer:
         finally:
             with self._lock:
                 self._conns.discard(sock)
+                self._acting.pop(sock, None)
             sock.close()
 
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 
 from confront.arena.control import ControlConfig
 from confront.engine.battle import BattleSpec
-from confront.engine.bridge import TOKEN_ENV, BridgeServer, BridgeSettings, Policy
+from confront.engine.bridge import TOKEN_ENV, BridgeServer, BridgeSettings, Policy, RobotActing
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 
 BRIDGE_BOT = "confront.BridgeBot*"
@@ -46,7 +46,9 @@ class BridgedRun:
     (sending, and waiting for the answer; with ``lead`` = 0 the whole round trip) as the robots timed it,
     ``policy_us`` inside the policy, ``handling_us`` the server's own work (parse, format, send); per robot
     turn ``work_us_per_turn`` the robots' own time outside execute() (deciding, round trips included, and the
-    controller). Statistics of a round that a robot played in fallback are lost with its connection.
+    controller); ``behind``: decisions that robots acting themselves took from a copy of the policy that still
+    lacked the update of their previous observation. Statistics of a round that a robot played in fallback are
+    lost with its connection.
     """
 
     run: EngineRun
@@ -60,6 +62,7 @@ class BridgedRun:
     work_us_per_turn: float = float("nan")
     policy_us: float = float("nan")
     handling_us: float = float("nan")
+    behind: int = 0  # acting robots: decisions taken before the robot's previous observation was acknowledged
 
     @property
     def ok(self) -> bool:
@@ -83,6 +86,7 @@ def run_bridged_battle(
     controller: ControlConfig | None = None,
     history: bool = False,
     lead: int = 0,
+    acting: RobotActing | None = None,
 ) -> BridgedRun:
     """Run ``spec`` (whose contestants include BridgeBot tanks) with ``policy`` deciding for every BridgeBot.
 
@@ -91,11 +95,13 @@ def run_bridged_battle(
     controller themselves every turn (the answers' gun, radar and fire are then ignored), so a policy that
     only picks moves costs one round trip per ``every`` turns. ``history``: the robots send every turn's
     energies with the next observation and at the round's end; ``lead``: they ask that many turns ahead (see
-    ``BridgeSettings``). ``extra_robots``: robot jars or folders to add (e.g. exported PolicyBot opponents).
+    ``BridgeSettings``). ``acting``: the robots pick their moves from their own copy of the policy and send
+    each observation with the move taken, without waiting for an answer (:class:`RobotActing`; needs
+    ``controller``). ``extra_robots``: robot jars or folders to add (e.g. exported PolicyBot opponents).
     """
     opts = options or EngineOptions(cpu_constant_ms=BRIDGE_CPU_CONSTANT_MS)
     tmo = timeout_ms if timeout_ms is not None else bridge_timeout_ms(opts.cpu_constant_ms)
-    with BridgeServer(policy, settings=BridgeSettings(every, controller, history, lead)) as server:
+    with BridgeServer(policy, settings=BridgeSettings(every, controller, history, lead, acting)) as server:
         run = run_battle(spec, bridge_options(opts, server.port, server.token, tmo), workdir=workdir,
                          extra_robots=extra_robots)
     st = server.stats
@@ -107,4 +113,5 @@ def run_bridged_battle(
                       rtt_over_1ms=st.rtt_over_1ms,
                       work_us_per_turn=st.work_us / st.robot_turns if st.robot_turns else nan,
                       policy_us=1e6 * st.policy_s / st.decisions if st.decisions else nan,
-                      handling_us=1e6 * st.handling_s / st.decisions if st.decisions else nan)
+                      handling_us=1e6 * st.handling_s / st.decisions if st.decisions else nan,
+                      behind=st.behind)

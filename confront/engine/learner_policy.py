@@ -22,9 +22,10 @@ import numpy as np
 
 from confront.arena.control import ControlConfig, move_commands
 from confront.arena.observe import ObservationConfig, reward_eq35
-from confront.engine.bridge import Observation, TurnEnergy
+from confront.engine.bridge import Observation, RobotActing, TurnEnergy
 from confront.engine.export import ExportedPolicy
 from confront.learning.base import Learner, Transition
+from confront.learning.tabular import TabularQ
 
 
 def history_rewards(history: Sequence[TurnEnergy], own_prev: float | None,
@@ -67,6 +68,8 @@ class LearnerPolicy:
         observation: ObservationConfig | None = None,
         control: ControlConfig | None = None,
         step_turns: int = 4,
+        acting: bool = True,
+        max_lag: int = 1,
     ) -> None:
         if step_turns < 1:
             raise ValueError(f"step_turns must be >= 1, got {step_turns}")
@@ -77,6 +80,10 @@ class LearnerPolicy:
         self.step_turns = step_turns
         self.obs_config = observation or ObservationConfig()
         self.control = control or ControlConfig()
+        self.acting = acting
+        self.max_lag = max_lag
+        self._updates: list[str] = []  # lines for the robots' own copies (robot_acting), drained by the bridge
+        self._sync = False  # a robot_acting() copy exists: queue every change of the Q table
         # the twin builds the learner's observation; its Q table is never used
         self._twin = ExportedPolicy("qtable", q=np.zeros((320, 4)), observation=self.obs_config,
                                     control=self.control, step_turns=step_turns)
@@ -89,8 +96,42 @@ class LearnerPolicy:
 
     def bridge_kwargs(self) -> dict[str, Any]:
         """The ``run_bridged_battle`` settings this policy needs: a decision every ``step_turns`` turns, the
-        gun/radar controller in Java, per-turn energy history."""
-        return {"every": self.step_turns, "controller": self.control, "history": True}
+        gun/radar controller in Java, per-turn energy history, and (``acting`` and a tabular learner) robots
+        that pick their moves from their own copy of the Q table (:meth:`robot_acting`)."""
+        return {"every": self.step_turns, "controller": self.control, "history": True,
+                "acting": self.robot_acting() if self.acting else None}
+
+    def robot_acting(self) -> RobotActing | None:
+        """The robots pick the moves themselves, from a copy of the learner's Q table with its exploration
+        (Boltzmann at its temperature, epsilon-greedy at its threshold; greedy with random ties when not
+        exploring), and Python only learns: every changed Q row and the exploration parameter after each update
+        go to every robot, and a robot waits when ``max_lag`` of its observations are not yet taken in. With
+        ``max_lag`` = 1 the move at decision k is drawn from the table with every update up to the step that
+        ended at decision k - 1 (the simulator's also has the step ending at k). None for learners other than
+        :class:`~confront.learning.tabular.TabularQ` (their moves are then decided in Python)."""
+        learner = self.learner
+        if not isinstance(learner, TabularQ) or learner.q.shape != (320, 4):
+            return None
+        self._sync = True
+        explore = learner.params.exploration_params()
+        kind = "greedy" if not self.explore else "boltzmann" if explore.kind == "boltzmann" else "egreedy"
+
+        def model() -> str:
+            return ExportedPolicy("qtable", q=learner.q, observation=self.obs_config, control=self.control,
+                                  step_turns=self.step_turns).to_text()
+
+        return RobotActing(model=model, explore=kind, param=self._param, max_lag=self.max_lag,
+                           seed=lambda: int(self.rng.integers(1 << 62)), updates=self._drain)
+
+    def _param(self) -> float:
+        """The learner's exploration parameter now: the temperature (Boltzmann) or the exploitation threshold."""
+        explore = self.learner.params.exploration_params()  # type: ignore[attr-defined]
+        step = self.learner.step  # type: ignore[attr-defined]
+        return explore.temperature(step) if explore.kind == "boltzmann" else explore.threshold(step)
+
+    def _drain(self) -> list[str]:
+        out, self._updates = self._updates, []
+        return out
 
     def _add_rewards(self, tank: _Tank, history: Sequence[TurnEnergy]) -> None:
         rewards, tank.own = history_rewards(history, tank.own, self.obs_config.reward_guard)
@@ -105,6 +146,12 @@ class LearnerPolicy:
             self.learner.learn(Transition(tank.obs, np.array([tank.action]), np.array([tank.rewards]), next_obs,
                                           np.array([done])))
             self.updates += 1
+            if self._sync:  # the robots' copies: the row that changed, and the exploration parameter now
+                s = int(tank.obs[0])
+                row = self.learner.q[s]  # type: ignore[attr-defined]
+                self._updates.append(f"Q {s} " + " ".join(repr(float(v)) for v in row))
+                if self.explore:
+                    self._updates.append(f"X {self._param()!r}")
 
     def __call__(self, obs: Observation) -> tuple[float, float, float, float, float]:
         """A decision turn: learn the step that ends here, pick the next move; gun, radar, fire are NaN (the
@@ -116,6 +163,10 @@ class LearnerPolicy:
         self._add_rewards(tank, obs.history)
         x = self._twin.learner_observation(obs, self.learner.observation)
         self._learn(tank, x, done=False)
+        if obs.action >= 0:  # the robot has moved itself (robot_acting): learn from the move it took
+            tank.obs, tank.action, tank.rewards = x, obs.action, []
+            self.decisions += 1
+            return (math.nan,) * 5
         tank.obs, tank.action, tank.rewards = x, int(self.learner.act(x, self.rng, explore=self.explore)[0]), []
         self.decisions += 1
         dist, turn = move_commands(np.array([tank.action]), self.control)

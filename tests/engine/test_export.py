@@ -246,3 +246,26 @@ def test_java_inference_equals_python_for_onehot_dmnn(install, tmp_path) -> None
     policy = ExportedPolicy.from_learner(_trained_like("dmnn_discrete"))
     lines = _random_observations(200, seed=9)
     _compare(policy, lines, _java_decisions(install, policy, lines, tmp_path))
+
+
+@pytest.mark.parametrize("cfg", [ObservationConfig(), ObservationConfig(include_position=True),
+                                 ObservationConfig(max_distance=500.0)])
+def test_one_robot_kernel_equals_the_batched_state_and_features(cfg: ObservationConfig) -> None:
+    """The twin's fast path (the simulator's one-robot kernel) gives the batched functions' state and float32
+    features exactly: no enemy, team-mates only, equally near enemies, headings beyond 2 pi and on bin edges."""
+    rng = np.random.default_rng(11)
+    twin = ExportedPolicy("qtable", q=np.zeros((320, 4)), observation=cfg)
+    cases = 0
+    for _ in range(600):
+        x, y = rng.uniform(18, 782), rng.uniform(18, 582)
+        scans = tuple(Scan(f"r{k}", 1, bool(rng.random() < 0.25), 0.0, 0.0, 0.0, 0.0, rng.uniform(0, 120),
+                           rng.uniform(0, 800), rng.uniform(0, 600)) for k in range(rng.integers(0, 6)))
+        if rng.random() < 0.2:  # two enemies at the same distance: the first one is the target
+            scans = (Scan("a", 1, False, 0, 0, 0, 0, 50.0, x + 30, y), Scan("b", 1, False, 0, 0, 0, 0, 40.0, x - 30, y))
+        heading = rng.choice([rng.uniform(-7, 14), 0.0, math.pi / 2, math.pi, 2 * math.pi, 1.5 * math.pi])
+        obs = Observation("me", (), 0, 1, x, y, heading, 0.0, 0.0, 0.0, rng.uniform(0, 100), 0.0, len(scans), 0.0,
+                          800.0, 600.0, scans)
+        (s1, f1), (s2, f2) = twin.state_and_features(obs), twin.state_and_features_batched(obs)
+        assert s1 == s2 and f1.dtype == f2.dtype == np.float32 and np.array_equal(f1, f2), obs
+        cases += 1
+    assert cases == 600

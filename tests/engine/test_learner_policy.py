@@ -51,8 +51,8 @@ def test_history_rewards_by_hand() -> None:
 def test_smdp_steps_learn_the_history_rewards() -> None:
     learner, ref = TabularQ(), TabularQ()
     twin = ExportedPolicy("qtable", q=np.zeros((320, 4)))
-    pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2)
-    assert pol.bridge_kwargs() == {"every": 2, "controller": pol.control, "history": True}
+    pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2, acting=False)
+    assert pol.bridge_kwargs() == {"every": 2, "controller": pol.control, "history": True, "acting": None}
     o1 = _obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),))
     m1 = pol(o1)  # first decision: nothing to learn yet
     assert pol.decisions == 1 and pol.updates == 0 and pol.reward_turns == 0
@@ -92,10 +92,13 @@ def test_observation_without_history_is_refused() -> None:
 
 
 @pytest.mark.engine
-def test_tabular_learner_trains_live_in_engine(install) -> None:
+@pytest.mark.parametrize("acting", [True, False])
+def test_tabular_learner_trains_live_in_engine(install, acting: bool) -> None:
+    """Decided in Python (one round trip per decision), or by the robot from its own copy of the Q table."""
     learner = TabularQ()
     q0 = learner.q.copy()
-    pol = LearnerPolicy(learner, np.random.default_rng(1), step_turns=4)
+    pol = LearnerPolicy(learner, np.random.default_rng(1), step_turns=4, acting=acting)
+    assert (pol.bridge_kwargs()["acting"] is not None) == acting
     res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SittingDuck"), rounds=2), pol, **pol.bridge_kwargs())
     assert res.ok, (res.failures, res.server_errors)
     turns = sum(int(r["turns"]) for r in res.run.summary["round_scores"])

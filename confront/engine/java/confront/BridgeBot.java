@@ -8,6 +8,7 @@ import java.io.StringReader;
 import java.net.InetAddress;
 import java.net.InetSocketAddress;
 import java.net.Socket;
+import java.util.SplittableRandom;
 import java.nio.charset.StandardCharsets;
 import java.util.HashMap;
 import java.util.LinkedHashMap;
@@ -44,6 +45,14 @@ import robocode.util.Utils;
  * answer switches the robot to a built-in behaviour for the rest of the round and prints
  * "CONFRONT bridge-failed REASON" for the runner to report. The "E" line carries the round's statistics:
  * decisions, their round-trip times, turns played and the robot's own work time outside execute().
+ *
+ * Acting mode (the hello reply's 7th field M > 0, followed by "acting EXPLORE PARAM SEED MAX_LAG" and a policy
+ * file): the robot picks its moves itself from its own copy of the Q table (PolicyModel, as PolicyBot does,
+ * with the learner's exploration: first maximum, random-tie greedy, Boltzmann or epsilon-greedy) and sends each
+ * observation with "MOVE;BEHIND" appended, never waiting for an answer. Python acknowledges each observation
+ * ("K TURN") and sends every change of the policy to every acting robot ("Q STATE V0 V1 V2 V3", "X PARAM"); the
+ * robot reads them without blocking at its decision turns, and waits (at most its timeout) only when MAX_LAG
+ * of its observations are unacknowledged. A closed connection or a bad line makes it fall back as above.
  */
 public class BridgeBot extends TeamRobot {
     static final int VERSION = 2;
@@ -59,6 +68,14 @@ public class BridgeBot extends TeamRobot {
     private long requestNanos;
     private boolean keepHistory;
     private PolicyModel controller;
+    // acting mode: the robot's own copy of the policy, kept current by Python's Q / X lines
+    private PolicyModel acting;
+    private String explore = "first";
+    private double param;
+    private SplittableRandom random;
+    private int maxLag;
+    private long sent;
+    private long acked;
     // per turn since the last message: TIME;OWN_ENERGY;TARGET;TARGET_PREVIOUS_ENERGY;TARGET_ENERGY, joined by "|"
     private final StringBuilder history = new StringBuilder();
     private Map<String, Double> lastEnergies = new HashMap<>();
@@ -91,7 +108,15 @@ public class BridgeBot extends TeamRobot {
             }
             if (!failed && !finished) {
                 try {
-                    if (!pending) {
+                    if (acting != null) {
+                        if (turn >= nextDecision) {
+                            while (nextDecision < turn) {
+                                nextDecision += every;  // a skipped turn passed a decision turn: take the next one
+                            }
+                            actSelf(turn);
+                            nextDecision += every;
+                        }
+                    } else if (!pending) {
                         while (nextDecision < turn) {
                             nextDecision += every;  // a skipped turn passed a decision turn: take the next one
                         }
@@ -100,7 +125,7 @@ public class BridgeBot extends TeamRobot {
                             pending = true;
                         }
                     }
-                    if (pending && turn >= nextDecision) {
+                    if (acting == null && pending && turn >= nextDecision) {
                         receive(nextDecision);  // late only when a skipped turn passed the decision turn
                         pending = false;
                         nextDecision += every;
@@ -140,7 +165,7 @@ public class BridgeBot extends TeamRobot {
                     + ",\"width\":" + getBattleFieldWidth() + ",\"height\":" + getBattleFieldHeight() + "}");
             String reply = in.readLine();
             String[] p = reply == null ? new String[0] : reply.split(" ");
-            if (p.length != 6 || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
+            if ((p.length != 6 && p.length != 7) || !p[0].equals("OK") || !p[1].equals(String.valueOf(VERSION))) {
                 fail("bad hello reply " + reply);
                 return;
             }
@@ -148,12 +173,17 @@ public class BridgeBot extends TeamRobot {
             lead = Integer.parseInt(p[3]);
             keepHistory = p[4].equals("1");
             int n = Integer.parseInt(p[5]);
-            if (every < 1 || lead < 0 || lead >= every || !(p[4].equals("0") || keepHistory) || n < 0 || n > 100) {
+            int m = p.length == 7 ? Integer.parseInt(p[6]) : 0;
+            if (every < 1 || lead < 0 || lead >= every || !(p[4].equals("0") || keepHistory) || n < 0 || n > 100
+                    || m < 0 || m > 1000000 || (m > 0 && (n == 0 || lead != 0))) {
                 fail("bad hello reply " + reply);
                 return;
             }
             if (n > 0) {
                 controller = controllerModel(n);
+            }
+            if (m > 0) {
+                actingModel(m);
             }
         } catch (IOException | RuntimeException e) {
             fail("connect: " + e.getClass().getSimpleName() + ": " + e.getMessage());
@@ -181,6 +211,171 @@ public class BridgeBot extends TeamRobot {
         return PolicyModel.read(new StringReader(text.append("matrix q 1 4\n0 0 0 0\n").toString()));
     }
 
+    /** The "acting EXPLORE PARAM SEED MAX_LAG" line and the policy file of the robot's own copy of the policy. */
+    private void actingModel(int m) throws IOException {
+        String head = in.readLine();
+        String[] p = head == null ? new String[0] : head.split(" ");
+        if (p.length != 5 || !p[0].equals("acting")
+                || !(p[1].equals("first") || p[1].equals("greedy") || p[1].equals("boltzmann") || p[1].equals("egreedy"))) {
+            throw new IOException("bad acting line " + head);
+        }
+        explore = p[1];
+        param = param(p[2]);
+        random = new SplittableRandom(Long.parseLong(p[3]));
+        maxLag = Integer.parseInt(p[4]);
+        if (maxLag < 1) {
+            throw new IOException("bad acting line " + head);
+        }
+        StringBuilder text = new StringBuilder();
+        for (int i = 1; i < m; i++) {
+            String line = in.readLine();
+            if (line == null) {
+                throw new IOException("policy file cut short");
+            }
+            text.append(line).append('\n');
+        }
+        acting = PolicyModel.read(new StringReader(text.toString()));
+        if (acting.q == null) {
+            throw new IOException("a robot that acts itself needs a Q table");
+        }
+    }
+
+    /** The exploration parameter: a temperature > 0 (Boltzmann) or a threshold in [0, 1]. */
+    private double param(String text) {
+        double v = finite(text);
+        if (explore.equals("boltzmann") ? !(v > 0) : (v < 0 || v > 1)) {
+            throw new IllegalArgumentException("exploration parameter " + text + " out of range for " + explore);
+        }
+        return v;
+    }
+
+    private static double finite(String text) {
+        double v = Double.parseDouble(text);
+        if (Double.isNaN(v) || Double.isInfinite(v)) {
+            throw new IllegalArgumentException("non-finite value " + text);
+        }
+        return v;
+    }
+
+    /**
+     * A decision turn when acting: take the updates that arrived (waiting only when maxLag observations are
+     * unacknowledged), pick the move from the own copy of the policy, set it, and send the observation with it.
+     */
+    private void actSelf(long turn) throws IOException {
+        long t0 = System.nanoTime();
+        while (in.ready()) {
+            update(in.readLine());
+        }
+        while (sent - acked >= maxLag) {
+            update(in.readLine());  // at most the socket's timeout, then the robot falls back
+        }
+        long waited = System.nanoTime() - t0;
+        int n = enemies.size();
+        double[] ex = new double[n];
+        double[] ey = new double[n];
+        double[] ee = new double[n];
+        int i = 0;
+        for (double[] v : enemies.values()) {
+            ex[i] = v[0];
+            ey[i] = v[1];
+            ee[i] = v[2];
+            i++;
+        }
+        double[] v = acting.moveValues(getX(), getY(), getHeadingRadians(), getEnergy(), ex, ey, ee,
+                getBattleFieldWidth(), getBattleFieldHeight());
+        int a = choose(v);
+        double[] mv = acting.move(a);
+        setAhead(mv[0]);
+        setTurnRightRadians(mv[1]);
+        request(turn, a + ";" + (sent - acked));
+        sent++;
+        long dt = waited + requestNanos;  // held up by Python: the wait for acknowledgements and the send
+        rttN++;
+        rttSum += dt;
+        if (dt > 1000000) {
+            rttSlow++;
+        }
+    }
+
+    /** One line from Python while acting: K (acknowledgement), Q (a Q-table row), X (exploration parameter). */
+    private void update(String line) throws IOException {
+        if (line == null) {
+            throw new IOException("python side closed the connection");
+        }
+        String[] p = line.split(" ");
+        if (p[0].equals("K") && p.length == 2) {
+            Long.parseLong(p[1]);
+            acked++;
+        } else if (p[0].equals("Q") && p.length == 6) {
+            int s = Integer.parseInt(p[1]);
+            if (s < 0 || s >= acting.q.length) {
+                throw new IllegalArgumentException("Q row " + s + " outside the table");
+            }
+            double[] row = new double[4];
+            for (int j = 0; j < 4; j++) {
+                row[j] = finite(p[j + 2]);
+            }
+            acting.q[s] = row;
+        } else if (p[0].equals("X") && p.length == 2) {
+            param = param(p[1]);
+        } else {
+            throw new IllegalArgumentException("bad update line '" + line + "'");
+        }
+    }
+
+    /** The move from its values: first maximum, a maximum at random, softmax at temperature param, or
+     *  epsilon-greedy with exploitation threshold param (confront.learning.exploration). */
+    private int choose(double[] v) {
+        switch (explore) {
+            case "greedy":
+                return randomMax(v);
+            case "egreedy":
+                return random.nextDouble() < param ? randomMax(v) : random.nextInt(v.length);
+            case "boltzmann": {
+                double m = Double.NEGATIVE_INFINITY;
+                for (double x : v) {
+                    m = Math.max(m, x / param);
+                }
+                double[] cdf = new double[v.length];
+                double sum = 0.0;
+                for (int i = 0; i < v.length; i++) {
+                    sum += Math.exp(v[i] / param - m);
+                    cdf[i] = sum;
+                }
+                double u = random.nextDouble() * sum;
+                int k = 0;
+                while (k < v.length && cdf[k] <= u) {
+                    k++;
+                }
+                return Math.min(k, v.length - 1);
+            }
+            default: {
+                int best = 0;
+                for (int i = 1; i < v.length; i++) {
+                    if (v[i] > v[best]) {
+                        best = i;
+                    }
+                }
+                return best;
+            }
+        }
+    }
+
+    private int randomMax(double[] v) {
+        double m = Double.NEGATIVE_INFINITY;
+        for (double x : v) {
+            m = Math.max(m, x);
+        }
+        int count = 0;
+        int pick = 0;
+        for (int i = 0; i < v.length; i++) {
+            if (v[i] == m && random.nextInt(++count) == 0) {
+                pick = i;  // reservoir sampling: each maximum with equal probability
+            }
+        }
+        return pick;
+    }
+
     private String teamName() {
         String[] mates = getTeammates();
         return mates == null ? "" : String.join(";", mates);
@@ -188,6 +383,11 @@ public class BridgeBot extends TeamRobot {
 
     /** Send the observation for decision turn ``turn`` (now, or ``lead`` turns before it). */
     private void request(long turn) throws IOException {
+        request(turn, null);
+    }
+
+    /** Send the observation for ``turn``; ``move``: the move this robot took itself (acting), else null. */
+    private void request(long turn, String move) throws IOException {
         StringBuilder b = new StringBuilder(256);
         b.append("O ").append(getRoundNum()).append(' ').append(turn)
                 .append(' ').append(getX()).append(' ').append(getY())
@@ -207,7 +407,11 @@ public class BridgeBot extends TeamRobot {
                 b.append(';').append(s[i]);
             }
         }
-        b.append("\t[").append(events).append("]\t").append(history).append('\n');
+        b.append("\t[").append(events).append("]\t").append(history);
+        if (move != null) {
+            b.append('\t').append(move);
+        }
+        b.append('\n');
         events.setLength(0);
         history.setLength(0);
         long t0 = System.nanoTime();
@@ -418,6 +622,11 @@ public class BridgeBot extends TeamRobot {
                 // with this round's round-trip and work-time statistics (a dead robot's output is not collected)
                 if (keepHistory) {
                     record();  // the state this robot ends the round in
+                }
+                if (acting != null) {
+                    while (in.ready()) {
+                        in.readLine();  // updates not yet read: closing with them unread resets the connection
+                    }
                 }
                 send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy() + " " + rttN + " "
                         + rttSum / 1000 + " " + rttSlow + " " + turnsPlayed + " " + workNanos / 1000 + "\t" + history);

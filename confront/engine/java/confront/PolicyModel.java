@@ -196,9 +196,9 @@ public final class PolicyModel {
         return h;
     }
 
-    /** Greedy move (first maximum) for own state and the enemies' last known positions/energies. */
-    public int act(double x, double y, double heading, double energy, double[] ex, double[] ey, double[] ee,
-                   double width, double height) {
+    /** The four move values for own state and the enemies' last known positions/energies. */
+    public double[] moveValues(double x, double y, double heading, double energy, double[] ex, double[] ey,
+                               double[] ee, double width, double height) {
         if (!"nearest".equals(keys.get("target"))) {
             throw new IllegalArgumentException("only target=nearest is exported");
         }
@@ -212,7 +212,13 @@ public final class PolicyModel {
         } else if (q == null) {
             in = features(x, y, heading, energy, t, ex, ey, ee, dmax, width, height);
         }
-        double[] v = values(s, in);
+        return values(s, in);
+    }
+
+    /** Greedy move (first maximum) for own state and the enemies' last known positions/energies. */
+    public int act(double x, double y, double heading, double energy, double[] ex, double[] ey, double[] ee,
+                   double width, double height) {
+        double[] v = moveValues(x, y, heading, energy, ex, ey, ee, width, height);
         int best = 0;
         for (int i = 1; i < v.length; i++) {
             if (v[i] > v[best]) {

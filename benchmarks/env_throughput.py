@@ -1,16 +1,24 @@
 """Throughput of the environments: Gymnasium step() calls/s, the vector env's and the SMDP team env's rates.
 
-Usage: ``python benchmarks/env_throughput.py [--seconds 2] [--json]``. Prints a table; with ``--json`` the
-last line is a JSON list of records (``env``, ``scenario``, ``batch``, ``turns_per_step``, ``steps_per_s``
-(step() calls), ``env_steps_per_s`` (battles x steps), ``turns_per_s``, ``robot_turns_per_s``,
+Usage: ``python benchmarks/env_throughput.py [--seconds 2] [--json] [--pool-only]``. Prints a table; with
+``--json`` the last line is a JSON list of records (``env``, ``scenario``, ``batch``, ``turns_per_step``,
+``steps_per_s`` (step() calls), ``env_steps_per_s`` (battles x steps), ``turns_per_s``, ``robot_turns_per_s``,
 ``steps_per_cpu_s`` (step() calls per second of the process' CPU time: with threads above the wall rate,
 on a busy machine a steadier figure for single-threaded rows)).
+
+``pool`` rows time ``PoolEnv.step`` alone (the PPO tanks' environment: tank view, tank actions, score
+reward, T = 5) over the league of ``confront/experiments/configs/tanks-demo.toml`` (5 entries x 24 battles)
+and ``tanks.toml`` (22 entries x 12), random joint tank actions; ``batch`` = agents (learning tanks),
+``steps_per_s`` x batch = learner decisions per second. The caller-driven opponents run their Python
+policies (dodge, strafe; a random-weight snapshot for ``self``), except the TD team: random paper moves
+(training it would take minutes).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import time
 from collections.abc import Callable
 
@@ -86,13 +94,56 @@ def bench_team(scenario: str, opponents: str, batch: int, turns: int, seconds: f
             "robot_turns_per_s": r * batch * turns * n}
 
 
+def _league_pool(config: str):  # noqa: ANN202 - a PoolEnv
+    """The PoolEnv of an experiment config's league (see the module docstring)."""
+    from confront.arena.pool import PoolEntry, PoolEnv
+    from confront.experiments import tanks
+    from confront.experiments.spec import load_experiment
+
+    cfg = load_experiment(config)
+    space = tanks.tank_space(cfg)
+    snap = tanks.SnapshotPolicy(space.dims)
+    rng = np.random.default_rng(0)
+    sizes = [space.n_features, 64, 64, sum(space.dims)]
+    snap.load({f"{w}{i}": (rng.normal(0, 0.1, (sizes[i + 1], sizes[i])) if w == "w" else np.zeros(sizes[i + 1]))
+               for i in range(3) for w in "wb"})
+    policies = {"td": tanks.random_policy, "random": tanks.random_policy, "dodge": tanks.dodge_policy,
+                "strafe": tanks.strafe_policy(space), "self": snap}
+    entries = []
+    for e in cfg.league.opponents:
+        scen, _, opp = e.partition(":")
+        pol = policies.get(opp)
+        entries.append(PoolEntry(e, scen, "td" if pol is not None else opp, cfg.league.battles, policy=pol,
+                                 opponent_actions="paper" if opp in ("td", "random", "dodge") else "same"))
+    return PoolEnv(entries, tanks.smdp_tank_config(cfg), seed=0)
+
+
+def bench_pool(config: str, seconds: float) -> dict:
+    pool = _league_pool(config)
+    pool.reset()
+    acts = np.random.default_rng(0).integers(0, int(np.prod(pool.action_dims)), size=(64, pool.n_agents))
+
+    def step(i: int) -> None:
+        pool.step(acts[i % 64])
+
+    r = _rate(step, seconds)
+    turns = pool.envs[0].turns_per_step
+    robots = sum(env.n_battles * env.n_robots for env in pool.envs)
+    return {"env": "pool", "scenario": config, "batch": pool.n_agents, "turns_per_step": turns, "steps_per_s": r,
+            "env_steps_per_s": r * sum(env.n_battles for env in pool.envs),
+            "turns_per_s": r * turns * sum(env.n_battles for env in pool.envs),
+            "robot_turns_per_s": r * turns * robots}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=2.0, help="measuring time per row")
     ap.add_argument("--json", action="store_true", help="print the records as JSON on the last line")
+    ap.add_argument("--pool-only", action="store_true", help="only the PoolEnv rows (the PPO tanks' leagues)")
     args = ap.parse_args()
     s = args.seconds
-    rows = [
+    pools = [bench_pool("tanks-demo", s), bench_pool("tanks", s)]
+    rows = [] if args.pool_only else [
         bench_gym("1v1", "SpinBot", 10, s),
         bench_gym("1v1", "SpinBot", 1, s),
         bench_gym("4v4", "SpinBot", 10, s),
@@ -104,14 +155,17 @@ def main() -> None:
         bench_team("4v4", "SpinBot", 256, 10, s),
         bench_team("4v10", "td", 256, 10, s),
     ]
+    CPU_RATES[:] = CPU_RATES[2:] + CPU_RATES[:2]  # the pool rows were measured first
+    rows += pools
     for r, cpu in zip(rows, CPU_RATES, strict=True):
         r["steps_per_cpu_s"] = cpu
-    head = f"{'env':<7}{'scenario':<9}{'batch':>6}{'T':>4}{'step()/s':>12}{'env-steps/s':>14}{'turns/s':>13}" \
+    print(f"load average {os.getloadavg()[0]:.1f}; pool rows: batch = learning tanks, decisions/s = step()/s x batch")
+    head = f"{'env':<7}{'scenario':<11}{'batch':>6}{'T':>4}{'step()/s':>12}{'env-steps/s':>14}{'turns/s':>13}" \
            f"{'robot-turns/s':>16}{'step()/cpu-s':>14}"
     print(head)
     print("-" * len(head))
     for r in rows:
-        print(f"{r['env']:<7}{r['scenario']:<9}{r['batch']:>6}{r['turns_per_step']:>4}{r['steps_per_s']:>12,.0f}"
+        print(f"{r['env']:<7}{r['scenario']:<11}{r['batch']:>6}{r['turns_per_step']:>4}{r['steps_per_s']:>12,.0f}"
               f"{r['env_steps_per_s']:>14,.0f}{r['turns_per_s']:>13,.0f}{r['robot_turns_per_s']:>16,.0f}"
               f"{r['steps_per_cpu_s']:>14,.0f}")
     if args.json:

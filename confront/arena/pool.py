@@ -17,11 +17,12 @@ snapshot of the policy) get their actions from the entry's ``policy(discrete (n,
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .smdp import LEARNER, SMDPConfig, TeamBattleEnv
+from .smdp import LEARNER, SMDPConfig, StepResult, TeamBattleEnv, _pool, _smdp_turns
 
 __all__ = ["PoolEntry", "PoolEnv", "PoolStep", "OpponentPolicy"]
 
@@ -71,6 +72,8 @@ class PoolEnv:
         self.envs = [TeamBattleEnv(e.scenario, n_battles=e.battles, seed=seed * 1000 + k, opponents=e.opponents,
                                    config=config, opponent_actions=e.opponent_actions)  # type: ignore[arg-type]
                      for k, e in enumerate(entries)]
+        for env in self.envs:  # only the caller-driven robots' views are read (a scripted bot's is not)
+            env.view_robots = env.learner.copy()
         self.ours = [env.team_ids() == 0 for env in self.envs]
         self.theirs = [env.learner & (env.team_ids() != 0) for env in self.envs]
         sizes = [env.n_battles * int(o.sum()) for env, o in zip(self.envs, self.ours, strict=True)]
@@ -107,11 +110,14 @@ class PoolEnv:
         return np.concatenate([f[:, o].reshape(-1, f.shape[-1]) for f, o in zip(feats, self.ours, strict=True)])
 
     def step(self, actions: np.ndarray) -> PoolStep:
-        """Every env one SMDP step with the agents' ``actions`` (N,)."""
+        """Every env one SMDP step with the agents' ``actions`` (N,).
+
+        The entries' compiled kernels run together on the thread pool (largest first); each entry's results
+        are gathered as soon as its kernels are done, while the others still run."""
         a = np.asarray(actions, dtype=np.int64)
         if a.shape != (self.n_agents,):
             raise ValueError(f"actions must have shape ({self.n_agents},), got {a.shape}")
-        obs, rew, done, active, rounds = [], [], [], [], []
+        full_actions = []
         for k, (entry, env) in enumerate(zip(self.entries, self.envs, strict=True)):
             ours, theirs = self.ours[k], self.theirs[k]
             full = np.zeros((env.n_battles, env.n_robots), dtype=np.int64)
@@ -120,7 +126,14 @@ class PoolEnv:
                 d, f = self._disc[k][:, theirs], self._feats[k][:, theirs]
                 full[:, theirs] = np.asarray(entry.policy(d.reshape(-1), f.reshape(-1, f.shape[-1]), self.rng),
                                              dtype=np.int64).reshape(env.n_battles, -1)
-            res = env.step(full)
+            full_actions.append(full)
+        if any(env._recording is not None for env in self.envs):
+            results = [env.step(full) for env, full in zip(self.envs, full_actions, strict=True)]
+        else:
+            results = self._step_together(full_actions)
+        obs, rew, done, active, rounds = [], [], [], [], []
+        for k, (entry, res) in enumerate(zip(self.entries, results, strict=True)):
+            ours = self.ours[k]
             self._disc[k], self._feats[k] = res.discrete, res.features
             obs.append(res.features[:, ours].reshape(-1, res.features.shape[-1]))
             rew.append(res.rewards[:, ours].sum(axis=2).reshape(-1))
@@ -136,6 +149,29 @@ class PoolEnv:
                                    "won": bool(end.decided[b] and end.alive[b][ours].any())})
         return PoolStep(np.concatenate(obs), np.concatenate(rew), np.concatenate(done), np.concatenate(active),
                         rounds)
+
+    def _step_together(self, full_actions: list[np.ndarray]) -> list[StepResult]:
+        """Every env's step (what ``env.step`` does) with all the kernels submitted at once."""
+        begun = [env._begin(full) for env, full in zip(self.envs, full_actions, strict=True)]
+        workers = _pool()._max_workers
+        whole = len(self.envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
+        calls = []
+        for k, (env, (rewards, _, obs)) in enumerate(zip(self.envs, begun, strict=True)):
+            calls.extend((k, c) for c in env._kernel_calls(0, env.turns_per_step, rewards, obs, whole=whole))
+        calls.sort(key=lambda kc: -(kc[1][1] - kc[1][0]) * self.envs[kc[0]].n_robots)  # largest first
+        futures: list[list[Future]] = [[] for _ in self.envs]
+        if workers == 1:
+            for _, c in calls:
+                _smdp_turns(*c)
+        else:
+            for k, c in calls:
+                futures[k].append(_pool().submit(_smdp_turns, *c))
+        results = []
+        for env, fs, (rewards, active, obs) in zip(self.envs, futures, begun, strict=True):
+            for f in fs:
+                f.result()
+            results.append(env._finish(rewards, active, obs))
+        return results
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """Every env's state and the last observations (data only)."""

@@ -158,16 +158,22 @@ def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, r
     be; 10 fixed-point iterations."""
     speed = 20.0 - 3.0 * power
     px, py, t = mx, my, 0.0
+    sh, ch = np.sin(mh), np.cos(mh)
+    linear = abs(rate) < 1e-9
     for _ in range(10):
         tau = age + t
-        if abs(rate) < 1e-9:
-            ox, oy = np.sin(mh) * mv * tau, np.cos(mh) * mv * tau
+        if linear:
+            ox, oy = sh * mv * tau, ch * mv * tau
         else:
-            ox = mv / rate * (np.cos(mh) - np.cos(mh + rate * tau))
-            oy = mv / rate * (np.sin(mh + rate * tau) - np.sin(mh))
+            a = mh + rate * tau
+            ox = mv / rate * (ch - np.cos(a))
+            oy = mv / rate * (np.sin(a) - sh)
         px = min(max(mx + ox, WALL_MARGIN), width - WALL_MARGIN)
         py = min(max(my + oy, WALL_MARGIN), height - WALL_MARGIN)
-        t = np.hypot(px - x, py - y) / speed
+        t_new = np.hypot(px - x, py - y) / speed
+        if t_new == t:  # a fixed point: every further iteration gives the same point
+            break
+        t = t_new
     return px, py
 
 
@@ -210,18 +216,21 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
     out[9] = n_en_alive / n_en if n_en > 0 else 0.0
     out[10] = n_mate_alive / n_mate if n_mate > 0 else 0.0
     # enemies: selection by distance to the remembered position (k_slots smallest, ties to the lower index)
-    used = np.zeros(n, dtype=np.bool_)
+    # (each distance computed once; a chosen or ineligible robot's is inf)
+    dist = np.empty(n)
+    for j in range(n):
+        if team[j] == team[i] or not alive[j] or seen[i, j] < 0:
+            dist[j] = np.inf
+        else:
+            dist[j] = np.hypot(memory[M_X, i, j] - x[i], memory[M_Y, i, j] - y[i])
     for s in range(k_slots):
         best, best_d = -1, np.inf
         for j in range(n):
-            if used[j] or team[j] == team[i] or not alive[j] or seen[i, j] < 0:
-                continue
-            d = np.hypot(memory[M_X, i, j] - x[i], memory[M_Y, i, j] - y[i])
-            if d < best_d:
-                best, best_d = j, d
+            if dist[j] < best_d:
+                best, best_d = j, dist[j]
         if best < 0:
             break
-        used[best] = True
+        dist[best] = np.inf
         slots[s] = best
         o = OWN_FEATURES + ENEMY_FEATURES * s
         bearing = np.arctan2(memory[M_X, i, best] - x[i], memory[M_Y, i, best] - y[i])
@@ -237,18 +246,21 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
         out[o + 7] = min(time - seen[i, best], MAX_AGE) / MAX_AGE
         out[o + 8] = min(max(memory[M_DROP, i, best], 0.0), 3.0) / 3.0
     # team-mates: as their last team messages said
-    used[:] = False
-    for s in range(m_slots if mates_ok else 0):
+    m_used = m_slots if mates_ok else 0
+    if m_used > 0:
+        for j in range(n):
+            if j == i or team[j] != team[i] or not alive[j]:
+                dist[j] = np.inf
+            else:
+                dist[j] = np.hypot(mates[0, j] - x[i], mates[1, j] - y[i])
+    for s in range(m_used):
         best, best_d = -1, np.inf
         for j in range(n):
-            if used[j] or j == i or team[j] != team[i] or not alive[j]:
-                continue
-            d = np.hypot(mates[0, j] - x[i], mates[1, j] - y[i])
-            if d < best_d:
-                best, best_d = j, d
+            if dist[j] < best_d:
+                best, best_d = j, dist[j]
         if best < 0:
             break
-        used[best] = True
+        dist[best] = np.inf
         o = OWN_FEATURES + ENEMY_FEATURES * k_slots + MATE_FEATURES * s
         rel = np.arctan2(mates[0, best] - x[i], mates[1, best] - y[i]) - h[i]
         out[o] = 1.0

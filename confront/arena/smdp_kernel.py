@@ -1,0 +1,243 @@
+"""The compiled SMDP step of :class:`confront.arena.smdp.TeamBattleEnv`: the learning tanks' moves
+(``_prepare``), the gun/radar controller (``controller_turn``) and T turns of battles with rewards and
+observations (``_smdp_turns``).
+
+A module of its own so that the Python side of the env (smdp.py) can change without recompiling the kernel;
+``_purge_stale_cache`` drops the numba cache of this module when a module the kernel calls into changed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+from . import _kernels as K
+from .bots import bots_step
+from .observe import float_mod, observe_kernel, perceive_row, remember_scans, reward_eq35_scalar, target_of
+from .state import HIT_ROBOT_SLOTS
+from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
+
+
+def _purge_stale_cache() -> None:
+    """Drop this module's numba cache when a module its kernel calls into changed.
+
+    Numba's cache of ``_smdp_turns`` embeds the compiled turn kernel and bots of other modules but only
+    checks this file's time stamp; a stale copy would run old code (or crash) after they change.
+    """
+    here = Path(__file__).resolve()
+    cache = here.parent / "__pycache__"
+    deps = ("_kernels.py", "bots.py", "rules.py", "state.py", "observe.py", "tank.py", "smdp_kernel.py")
+    h = hashlib.sha256()
+    for name in deps:
+        f = here.parent / name
+        h.update(f.read_bytes() if f.is_file() else b"")
+    stamp = cache / "smdp_kernel.deps"
+    digest = h.hexdigest()
+    try:
+        if stamp.is_file() and stamp.read_text() == digest:
+            return
+        for f in cache.glob("smdp_kernel.*.nb[ic]"):
+            f.unlink(missing_ok=True)
+        cache.mkdir(exist_ok=True)
+        stamp.write_text(digest)
+    except OSError:  # read-only install: numba then caches elsewhere or not at all
+        pass
+
+
+_purge_stale_cache()
+C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = range(9)
+
+
+@njit(cache=True)
+def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndarray, tables: np.ndarray,
+             n_act: np.ndarray, slots: np.ndarray, move: np.ndarray, power: np.ndarray, chosen: np.ndarray,
+             active: np.ndarray) -> bool:
+    """Learning tanks' move (distance, body turn), fire power and chosen target robot for the step (from
+    their action table and the enemy slots of their last view), and ``active`` (a learning tank alive in a
+    battle not done). Returns True, changing nothing, if an action is out of range."""
+    nb, n = actions.shape
+    for b in range(nb):
+        for i in range(n):
+            if space[i] >= 0 and not 0 <= actions[b, i] < n_act[space[i]]:
+                return True
+    for b in range(nb):
+        for i in range(n):
+            sp = space[i]
+            a = actions[b, i] if sp >= 0 else 0
+            row = tables[max(sp, 0), a]
+            move[b, i, 0] = row[0]
+            move[b, i, 1] = row[1]
+            move[b, i, 2] = row[4]
+            move[b, i, 3] = row[5]
+            power[b, i] = row[2]
+            k = int(row[3])
+            chosen[b, i] = slots[b, i, k] if sp >= 0 and 0 <= k < slots.shape[2] else -1
+            active[b, i] = sp >= 0 and rb[b, K.ALIVE, i] and not bb[b, K.DONE]
+    return False
+
+
+@njit(cache=True)
+def _relative(a: float) -> float:
+    """Angle wrapped to [-pi, pi) (Utils.normalRelativeAngle, as control._rel)."""
+    return float_mod(a + np.pi, 2 * np.pi) - np.pi
+
+
+@njit(cache=True)
+def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: float, ctrl: np.ndarray,
+                    power: float, cmd: np.ndarray) -> None:
+    """Gun turn, radar turn and fire power of a living learning tank (control.aim's rule) toward its
+    target ``tgt`` known at (tx, ty).
+
+    The radar turns to the target plus an overshoot, the gun to the target; the tank fires when the gun
+    is within the tolerance, the gun is cold and it has energy; power by distance band, or ``power`` > 0;
+    never with ``power`` < 0 (hold fire).
+    Without a target the radar spins a full turn and the gun keeps its command.
+    """
+    if tgt < 0:
+        cmd[b, i, 3] = 2 * np.pi
+        cmd[b, i, 4] = 0.0
+        return
+    dx = tx - rf[b, K.X, i]
+    dy = ty - rf[b, K.Y, i]
+    bearing = np.arctan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise
+    dist = np.hypot(dx, dy)
+    gun_turn = _relative(bearing - rf[b, K.GH, i])
+    radar_turn = _relative(bearing - rf[b, K.RH, i])
+    radar_turn = radar_turn + np.sign(radar_turn) * ctrl[C_OVERSHOOT]
+    cmd[b, i, 2] = gun_turn
+    cmd[b, i, 3] = radar_turn
+    fire = abs(gun_turn) <= ctrl[C_TOL] and rf[b, K.HEAT, i] == 0 and rf[b, K.E, i] > 0 and ctrl[C_FIRE] > 0
+    if not fire or power < 0:
+        cmd[b, i, 4] = 0.0
+    elif power > 0:
+        cmd[b, i, 4] = power
+    elif dist < ctrl[C_NEAR]:
+        cmd[b, i, 4] = ctrl[C_PNEAR]
+    elif dist < ctrl[C_FAR]:
+        cmd[b, i, 4] = ctrl[C_PMID]
+    else:
+        cmd[b, i, 4] = ctrl[C_PFAR]
+
+
+@njit(cache=True, nogil=True)
+def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
+                rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
+                placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
+                rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
+                view_mask):
+    """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
+    t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
+    per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of
+    the team's score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
+    disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0, of the robots in
+    ``view_mask`` (R,); the others' rows zero, their slots -1). Returns the turn index
+    where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
+    run in parallel threads. Each robot picks its target and aims from its own picture
+    (observe.perceive_row); after each turn the robots' scans go into ``memory``."""
+    n = rf.shape[2]
+    vx, vy, ve, va = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    margin = ctrl[C_REWARD] > 0
+    before = np.zeros((b1 - b0, n))
+    for t in range(t0, t1):
+        any_live = False
+        for b in range(b0, b1):
+            if bb[b, K.DONE]:
+                buf[3, b, :] = 0.0
+                continue
+            any_live = True
+            for i in range(n):
+                perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
+                             scan_time[b], sensing, vx, vy, ve, va)
+                tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
+                c = chosen[b, i]
+                if c >= 0 and va[c]:
+                    tg = c
+                buf[0, b, i] = tg
+                buf[1, b, i] = rf[b, K.E, i]
+                buf[2, b, i] = rf[b, K.E, tg] if tg >= 0 else 0.0
+                buf[3, b, i] = 1.0 if rb[b, K.ALIVE, i] and tg >= 0 else 0.0
+                if learner[i]:
+                    # moves are written once at the start of the SMDP step (set* semantics), then kept
+                    cmd[b, i, 0] = move[b, i, 0] if t == 0 else np.nan
+                    cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
+                    if t == 0 and move[b, i, 2] > 0 and tg >= 0:  # turn relative to the target's bearing
+                        bearing = np.arctan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
+                        cmd[b, i, 1] = _relative(bearing + move[b, i, 1] - rf[b, K.H, i])
+                    cmd[b, i, 2] = np.nan
+                    cmd[b, i, 3] = np.nan
+                    cmd[b, i, 4] = 0.0
+                    if rb[b, K.ALIVE, i]:
+                        tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
+                        if tg >= 0 and move[b, i, 3] > 0 and sensing == 1:
+                            aim_power = power[b, i] if power[b, i] > 0 else 2.0
+                            rate = memory[b, M_TURN, i, tg] if move[b, i, 3] > 1 else 0.0
+                            tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, M_H, i, tg],
+                                                memory[b, M_V, i, tg], rate,
+                                                float(bi[b, K.TIME] - scan_time[b, i, tg]), aim_power, width, height)
+                        controller_turn(rf, b, i, tg, tx, ty, ctrl, power[b, i], cmd)
+                else:
+                    for c in range(4):
+                        cmd[b, i, c] = np.nan
+                    cmd[b, i, 4] = 0.0
+        if not any_live:
+            t1 = t
+            break
+        if has_bots:
+            r = slice(b0, b1)
+            bots_step(kinds, mem[r], rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.GH], rf[r, K.RH], rf[r, K.E],
+                      rb[r, K.ALIVE], ri[r, K.TEAM], rf[r, K.DIST], rf[r, K.BODYREM], rf[r, K.GUNREM],
+                      rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
+                      rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
+                      rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem,
+                      rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.HEAT])
+        if k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
+            for b in range(b0, b1):
+                mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
+                for i in range(n):
+                    mates[b, 0, i] = rf[b, K.X, i]
+                    mates[b, 1, i] = rf[b, K.Y, i]
+                    mates[b, 2, i] = rf[b, K.E, i]
+                    if margin:
+                        before[b - b0, i] = score[b, i].sum()
+        # one Robocode turn of these battles (what Arena.step runs)
+        K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                     placements, placements_total, cmd, params, scratch_i, scratch_f)
+        for b in range(b0, b1):
+            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],
+                           float(bi[b, K.TIME]), memory[b])
+            if margin:
+                for i in range(n):
+                    if not learner[i]:
+                        continue
+                    m = 0.0
+                    for j in range(n):
+                        d = score[b, j].sum() - before[b - b0, j]
+                        m += d if ri[b, K.TEAM, j] == ri[b, K.TEAM, i] else -d
+                    rewards[b, i, t] = m
+                continue
+            for i in range(n):
+                if buf[3, b, i] > 0:
+                    tg = int(buf[0, b, i])
+                    rewards[b, i, t] = reward_eq35_scalar(buf[1, b, i], rf[b, K.E, i], buf[2, b, i],
+                                                          rf[b, K.E, tg], guard)
+    r = slice(b0, b1)
+    observe_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.E], rb[r, K.ALIVE], ri[r, K.TEAM], memory[r],
+                   scan_time[r], sensing, rule, max_distance, width, height, target[r], disc[r], feats[r])
+    if k_slots > 0:  # the tank views of the robots in view_mask (the others' rows zero, no slots)
+        row = np.zeros(view.shape[2])
+        for b in range(b0, b1):
+            tb = float(bi[b, K.TIME])
+            for i in range(n):
+                if view_mask[i]:
+                    tank_view_row(rf[b, K.X], rf[b, K.Y], rf[b, K.H], rf[b, K.V], rf[b, K.E], rf[b, K.HEAT],
+                                  rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b], scan_time[b], tb, width, height,
+                                  k_slots, m_slots, mates[b], mates_ok[b], row, slots[b, i])
+                    for q in range(row.shape[0]):
+                        view[b, i, q] = row[q]
+                else:
+                    view[b, i, :] = 0.0
+                    slots[b, i, :] = -1
+    return t1

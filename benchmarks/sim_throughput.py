@@ -1,8 +1,14 @@
 """Robot-turns per second of the arena (engine column ``sim``) and, when installed, the real engine.
 
-Usage: ``python benchmarks/sim_throughput.py [--json] [--seconds S] [--order engine|shuffle|fixed]``.
+Usage: ``python benchmarks/sim_throughput.py [--json] [--seconds S] [--order engine|shuffle|fixed] [--plot PNG]``.
 Prints a table; with ``--json`` the last line is one JSON list of records with keys scenario, batch,
-engine, turns_per_s, robot_turns_per_s.
+engine, turns_per_s, robot_turns_per_s (team-env rows add decisions_per_s, threads).
+
+``team-env`` rows: :class:`TeamBattleEnv` with learner actions, the learner-facing path: 4v4 against SpinBot,
+T = 10, uniformly random actions of the paper's 4 moves for the 4 learning tanks, ``batch`` battles;
+``decisions_per_s`` = learner decisions (alive or not) per second, ``robot_turns_per_s`` = alive robots x turns.
+``--plot PNG`` (``confront bench sim --plot``) writes the scaling figure instead: scripted 4v4 and the team env,
+throughput against batch size at 1 and 2 threads.
 
 Workloads (``--workload``): ``bots`` (default) plays the same sample robots as the engine column
 (confront.engine.bench's teams: ours SpinBot, Walls, Tracker, RamFire; them Walls, Tracker, Crazy,
@@ -117,6 +123,78 @@ def raw_step(scenario: str, seconds: float, order: str) -> dict:
             "robot_turns_per_s": alive / dt}
 
 
+def team_env(scenario: str, batch: int, seconds: float, threads: int | None = None, opponents: str = "SpinBot",
+             turns: int = 10) -> dict:
+    """TeamBattleEnv with random learner actions: decisions and alive robot-turns per second (best of 3)."""
+    import numba
+
+    from confront.arena.smdp import SMDPConfig, TeamBattleEnv
+
+    old = numba.get_num_threads()
+    if threads is not None:
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        env = TeamBattleEnv(scenario, batch, seed=1, opponents=opponents, config=SMDPConfig(turns_per_step=turns))
+    finally:
+        numba.set_num_threads(old)
+    env.reset()
+    learners = int(env.learner.sum())
+    acts = np.random.default_rng(0).integers(0, env.n_actions, size=(16, batch, env.n_robots))
+    env.step(acts[0])
+    best = (0.0, 0.0, 0.0)
+    for _ in range(3):
+        steps, robot_turns, i = 0, 0.0, 0
+        t0 = time.perf_counter()
+        while True:
+            alive = env.arena.state.alive.sum()
+            env.step(acts[i % 16])
+            robot_turns += (alive + env.arena.state.alive.sum()) / 2 * turns  # alive robots over the step, about
+            steps += 1
+            i += 1
+            if time.perf_counter() - t0 >= seconds / 3:
+                break
+        dt = time.perf_counter() - t0
+        if steps / dt > best[0]:
+            best = (steps / dt, robot_turns / dt, steps * batch * turns / dt)
+    return {"scenario": scenario, "batch": batch, "engine": "team-env", "threads": len(env._ranges),
+            "decisions_per_s": best[0] * batch * learners, "robot_turns_per_s": float(best[1]),
+            "turns_per_s": best[2]}
+
+
+def scaling_plot(path: str, seconds: float) -> list[dict]:
+    """Throughput against batch size at 1 and 2 threads (scripted 4v4, team env 4v4): the figure at ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    batches = (1, 4, 16, 64, 256, 1024)
+    rows: list[dict] = []
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for threads in (1, 2):
+        scripted = [sim_throughput("4v4", b, seconds, "engine", threads) for b in batches]
+        team = [team_env("4v4", b, seconds, threads) for b in batches]
+        for r in scripted + team:
+            r["threads"] = threads
+        rows += scripted + team
+        axes[0].plot(batches, [r["robot_turns_per_s"] / 1e6 for r in scripted], "o-", label=f"{threads} thread(s)")
+        axes[1].plot(batches, [r["decisions_per_s"] / 1e3 for r in team], "o-", label=f"{threads} thread(s)")
+    axes[0].set_title("scripted 4v4 (sample robots)")
+    axes[0].set_ylabel("alive robot-turns/s (M)")
+    axes[1].set_title("TeamBattleEnv 4v4 vs SpinBot, T=10, random actions")
+    axes[1].set_ylabel("learner decisions/s (k)")
+    for ax in axes:
+        ax.set_xscale("log", base=2)
+        ax.set_xlabel("battles (batch)")
+        ax.grid(alpha=0.3)
+        ax.legend()
+    fig.suptitle(f"confront simulator scaling (load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"wrote {path}")
+    return rows
+
+
 def engine_rows(scenario: str) -> list[dict]:
     """The real engine's rate on the same scenario, if helper code and the engine are available."""
     try:
@@ -141,7 +219,18 @@ def main() -> None:
     ap.add_argument("--scenarios", default=",".join(SCENARIOS))
     ap.add_argument("--workload", default="bots", choices=["bots", "random"])
     ap.add_argument("--no-engine", action="store_true", help="skip the real engine")
+    ap.add_argument("--team-batches", default="64,256", help="batches of the team-env rows ('' for none)")
+    ap.add_argument("--plot", default=None, metavar="PNG", help="write the scaling figure (and print its rows)")
     args = ap.parse_args()
+    if args.plot:
+        rows = scaling_plot(args.plot, args.seconds)
+        for r in rows:
+            rate = r.get("decisions_per_s", r["robot_turns_per_s"])
+            unit = "decisions/s" if "decisions_per_s" in r else "robot-turns/s"
+            print(f"{r['engine']:<10} threads {r['threads']} batch {r['batch']:>5}: {rate:>14,.0f} {unit}")
+        if args.json:
+            print(json.dumps(rows))
+        return
     rows: list[dict] = []
     for sc in args.scenarios.split(","):
         for b in BATCHES:
@@ -149,13 +238,17 @@ def main() -> None:
         rows.append(raw_step(sc, args.seconds, args.order))
         if not args.no_engine:
             rows.extend(engine_rows(sc))
+    for b in [int(v) for v in args.team_batches.split(",") if v]:
+        rows.append(team_env("4v4", b, args.seconds, args.threads))
     eng = {r["scenario"]: r["robot_turns_per_s"] for r in rows if r["engine"] == "robocode"}
     print(f"order={args.order}, threads={args.threads or 'all CPUs'}, load average {os.getloadavg()[0]:.1f}")
-    print(f"{'scenario':<8} {'batch':>6} {'engine':<13} {'turns/s':>14} {'robot-turns/s':>15} {'x engine':>9}")
+    print(f"{'scenario':<8} {'batch':>6} {'engine':<13} {'turns/s':>14} {'robot-turns/s':>15} {'x engine':>9}"
+          f" {'decisions/s':>13}")
     for r in rows:
         ratio = r["robot_turns_per_s"] / eng[r["scenario"]] if r["scenario"] in eng else float("nan")
+        dec = f"{r['decisions_per_s']:>13,.0f}" if "decisions_per_s" in r else ""
         print(f"{r['scenario']:<8} {r['batch']:>6} {r['engine']:<13} {r['turns_per_s']:>14,.0f} "
-              f"{r['robot_turns_per_s']:>15,.0f} {ratio:>9,.0f}")
+              f"{r['robot_turns_per_s']:>15,.0f} {ratio:>9,.0f} {dec}")
     if args.json:
         print(json.dumps(rows))
 

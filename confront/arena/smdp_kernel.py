@@ -141,6 +141,7 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     vx, vy, ve, va = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
     margin = ctrl[C_REWARD] > 0
     before = np.zeros((b1 - b0, n))
+    gain = np.zeros(n)
     for t in range(t0, t1):
         any_live = False
         for b in range(b0, b1):
@@ -149,6 +150,11 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 continue
             any_live = True
             for i in range(n):
+                if margin and not learner[i]:  # a scripted robot's target and energies feed only Eq. 35 rewards
+                    for c in range(4):
+                        cmd[b, i, c] = np.nan
+                    cmd[b, i, 4] = 0.0
+                    continue
                 perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
                              scan_time[b], sensing, vx, vy, ve, va)
                 tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
@@ -209,13 +215,14 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
             remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],
                            float(bi[b, K.TIME]), memory[b])
             if margin:
+                for j in range(n):  # each robot's score change this turn
+                    gain[j] = score[b, j].sum() - before[b - b0, j]
                 for i in range(n):
                     if not learner[i]:
                         continue
                     m = 0.0
                     for j in range(n):
-                        d = score[b, j].sum() - before[b - b0, j]
-                        m += d if ri[b, K.TEAM, j] == ri[b, K.TEAM, i] else -d
+                        m += gain[j] if ri[b, K.TEAM, j] == ri[b, K.TEAM, i] else -gain[j]
                     rewards[b, i, t] = m
                 continue
             for i in range(n):

@@ -219,11 +219,24 @@ def replay(source: Path, out: Path | None) -> None:
 @cli.command()
 @click.argument("what", type=click.Choice(["sim", "learner", "env", "bridge", "reproduce", "train", "all"]),
                 default="sim")
-def bench(what: str) -> None:
+@click.option("--plot", type=click.Path(path_type=Path), is_flag=False, flag_value=Path("sim_scaling.png"),
+              default=None, help="sim only: write the scaling figure (throughput against batch size and threads) "
+                                 "to this PNG (default sim_scaling.png) instead of the table.")
+def bench(what: str, plot: Path | None) -> None:
     """Run a benchmark script from benchmarks/ and print its table."""
     from confront.experiments.evaluate import bench_cli
 
-    bench_cli(what)
+    if plot is None:
+        bench_cli(what)
+        return
+    if what != "sim":
+        raise click.UsageError("--plot is for `confront bench sim`")
+    import subprocess
+
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "sim_throughput.py"
+    if not script.is_file():
+        raise FileNotFoundError("benchmarks/ is not here: run `confront bench` from a source checkout")
+    subprocess.run([sys.executable, str(script), "--plot", str(plot)], check=False)
 
 
 @cli.group(cls=Group)

@@ -327,11 +327,14 @@ def parse_observation(line: str, hello: dict[str, Any], acting: bool = False) ->
 def parse_history(text: str) -> tuple[TurnEnergy, ...]:
     """``TIME;ENERGY;TARGET;TARGET_PREVIOUS;TARGET_ENERGY`` records joined by "|" (empty: none)."""
     out = []
+    isfinite = math.isfinite
     for item in text.split("|") if text else ():
         f = item.split(";")
         if len(f) != 5:
             raise ValueError(f"bad history record: {item[:80]!r}")
-        own, prev, now = _floats((f[1], f[3], f[4]), "history value")
+        own, prev, now = float(f[1]), float(f[3]), float(f[4])
+        if not (isfinite(own) and isfinite(prev) and isfinite(now)):
+            raise ValueError(f"non-finite history value: {item[:80]!r}")
         out.append(TurnEnergy(int(f[0]), own, f[2], prev, now))
     return tuple(out)
 
@@ -475,6 +478,7 @@ class BridgeServer:
         self._lock = threading.Lock()
         self._conns: set[socket.socket] = set()
         self._acting: dict[socket.socket, str] = {}  # robots that act themselves: their update streams
+        self._sessions: list[threading.Thread] = []
         self._thread: threading.Thread | None = None
 
     def start(self) -> BridgeServer:
@@ -578,13 +582,23 @@ class BridgeServer:
             sock.close()
             self._error(f"{hello['name']}: refused, {MAX_ROBOTS} robots already connected")
             return
-        threading.Thread(target=self._serve, args=(sock, hello, rest), daemon=True).start()
+        thread = threading.Thread(target=self._serve, args=(sock, hello, rest), daemon=True)
+        with self._lock:
+            self._sessions = [t for t in self._sessions if t.is_alive()] + [thread]
+        thread.start()
 
-    def stop(self) -> None:
-        """Stop serving and close every socket."""
+    def stop(self, drain_s: float = 5.0) -> None:
+        """Stop serving and close every socket. With robots acting themselves, sessions get up to ``drain_s``
+        seconds to take in what their robot sent before it closed its end (such robots do not wait for their
+        last observations and end line to be read)."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5)
+        deadline = time.monotonic() + (drain_s if self.settings.acting is not None else 0.0)
+        with self._lock:
+            sessions = list(self._sessions)
+        for thread in sessions:
+            thread.join(timeout=max(0.0, deadline - time.monotonic()))
         with self._lock:
             for sock in self._conns:
                 with contextlib.suppress(OSError):

@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from confront.arena.control import ControlConfig, move_commands
+from confront.arena.observe import reward_eq35, reward_eq35_scalar
 from confront.engine.battle import BattleSpec
 from confront.engine.bridge import Observation, Scan, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
 from confront.engine.export import ExportedPolicy
-from confront.engine.learner_policy import LearnerPolicy, history_rewards
+from confront.engine.learner_policy import LearnerPolicy, eq35, history_rewards
 from confront.learning.base import Transition
 from confront.learning.tabular import TabularQ
 
@@ -46,6 +48,15 @@ def test_history_rewards_by_hand() -> None:
     assert history_rewards((TurnEnergy(1, 50.0, "e", 50.5, 48.5),), 50.0)[0] == pytest.approx([4.0])
     assert history_rewards((TurnEnergy(1, 50.0, "e", 50.5, 48.5),), 50.0, guard=0.25)[0] == pytest.approx([8.0])
     assert history_rewards((), 42.0) == ([], 42.0)
+
+
+def test_plain_float_eq35_equals_the_arenas() -> None:
+    rng = np.random.default_rng(2)
+    vals = np.concatenate([rng.uniform(0, 100, (2000, 4)), rng.choice([0.0, 0.5, 1.0, 100.0], (500, 4))])
+    for guard in (1.0, 0.25):
+        for a, b, c, d in vals:
+            got = eq35(float(a), float(b), float(c), float(d), guard)
+            assert got == float(reward_eq35(a, b, c, d, guard)) == reward_eq35_scalar(a, b, c, d, guard)
 
 
 def test_smdp_steps_learn_the_history_rewards() -> None:
@@ -82,6 +93,48 @@ def test_smdp_steps_learn_the_history_rewards() -> None:
     assert pol.updates == 2
     with pytest.raises(ValueError, match="step_turns"):
         LearnerPolicy(learner, np.random.default_rng(0), step_turns=0)
+
+
+def test_acting_robots_learn_from_the_moves_taken_and_get_every_change() -> None:
+    """Observations that carry the robot's move: that move is learned, every learned row and the temperature
+    after it are queued for the robots, and the policy file of the next hello is the table as it is then."""
+    learned: list[int] = []
+
+    class Spy(TabularQ):
+        def learn(self, batch: Transition) -> dict[str, float]:
+            learned.append(int(batch.action[0]))
+            return super().learn(batch)
+
+    learner = Spy()
+    pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2)
+    acting = pol.bridge_kwargs()["acting"]
+    assert acting is not None and acting.explore == "boltzmann" and acting.max_lag == pol.max_lag == 1
+    start = acting.hello_lines()
+    assert start[0].split()[:2] == ["acting", "boltzmann"] and float(start[0].split()[2]) == pytest.approx(0.1)
+    assert "\n".join(start[1:]) + "\n" == ExportedPolicy("qtable", q=learner.q, step_turns=2).to_text()
+    twin = ExportedPolicy("qtable", q=np.zeros((320, 4)))
+    hist: tuple[TurnEnergy, ...] = (TurnEnergy(0, 100.0, "", 0.0, 0.0),)
+    prev_state = -1
+    for k, (own, enemy, ex, move) in enumerate([(100.0, 100.0, 400.0, 2), (97.0, 84.0, 100.0, 0),
+                                                (97.0, 80.0, 700.0, 3), (90.0, 70.0, 400.0, 1)]):
+        obs = replace(_obs(2 * k + 1, own, enemy, hist, ex=ex), action=move)
+        assert all(math.isnan(v) for v in pol(obs))  # nothing to answer
+        lines = acting.updates()
+        if k == 0:
+            assert lines == []  # nothing learned yet
+        else:
+            row = " ".join(repr(float(v)) for v in learner.q[prev_state])
+            temperature = learner.params.exploration_params().temperature(learner.step)
+            assert lines == [f"Q {prev_state} {row}", f"X {temperature!r}"]
+        prev_state = int(twin.learner_observation(obs, "discrete")[0])
+        hist = (TurnEnergy(2 * k + 1, own, "e", enemy, enemy - 3),
+                TurnEnergy(2 * k + 2, own, "e", enemy - 3, enemy - 3))
+    assert learned == [2, 0, 3] and pol.updates == 3 == learner.step and pol.decisions == 4
+    assert "\n".join(acting.hello_lines()[1:]) + "\n" == ExportedPolicy("qtable", q=learner.q, step_turns=2).to_text()
+    learner.load_state_dict({**learner.state_dict(), "q": np.ones((320, 4)), "step": np.array(7)})  # e.g. resumed
+    assert "\n".join(acting.hello_lines()[1:]) + "\n" == ExportedPolicy("qtable", q=np.ones((320, 4)),
+                                                                         step_turns=2).to_text()
+    assert LearnerPolicy(learner, np.random.default_rng(0), explore=False).robot_acting().explore == "greedy"
 
 
 def test_observation_without_history_is_refused() -> None:

@@ -8,7 +8,9 @@ robot's per-turn energy records (``Observation.history``, :class:`~confront.engi
 tank's energy and its target's (the nearest enemy by last scans, as the Java controller picks it). With
 ``train=True`` each finished SMDP step (the decision, the T per-turn rewards r_t..r_{t+T-1}, the next
 decision's observation) is passed to ``learner.learn`` at once; ``end_episode`` (death or round end) adds the
-last rewards and learns the open step as terminal.
+last rewards and learns the open step as terminal. With ``acting`` (the default) and a tabular learner the
+robots pick the moves themselves from their own copy of the Q table, kept current by every update
+(:meth:`LearnerPolicy.robot_acting`), so the engine does not wait for a round trip per decision.
 """
 
 from __future__ import annotations

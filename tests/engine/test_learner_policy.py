@@ -162,3 +162,14 @@ def test_tabular_learner_trains_live_in_engine(install, acting: bool) -> None:
     assert learner.step == pol.updates
     assert not np.array_equal(learner.q, q0)
     assert pol.reward_max > 0  # it hit the duck
+
+
+def test_learners_without_a_q_table_are_decided_in_python() -> None:
+    """A DMNN (or any learner other than TabularQ) keeps the round trip per decision: no copy for the robots."""
+    from confront.learning.dmnn import DMNN, DMNNParams
+
+    pol = LearnerPolicy(DMNN(DMNNParams(n_inputs=7), np.random.default_rng(0)), np.random.default_rng(0),
+                        step_turns=2)
+    assert pol.robot_acting() is None and pol.bridge_kwargs()["acting"] is None
+    move = pol(_obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),)))
+    assert _action(move) in range(4) and pol.decisions == 1

@@ -250,19 +250,12 @@ class TeamBattleEnv:
     def observe(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(target, discrete, features) of the current state for every robot (features: the tank view with
         tank actions, whose enemy slot maps then go to ``slots``)."""
-        s = self.arena.state
-        target, disc, feats = observe(s.x, s.y, s.heading, s.energy, s.alive, self.team, self.field,
-                                      self.config.observation, self._memory, s.scan_time)
-        tank = self.config.tank
-        if tank is None:
-            return target, disc, feats
-        view = np.empty(s.x.shape + (tank.n_features,), np.float32)
-        team_b = np.ascontiguousarray(np.broadcast_to(self.team, s.x.shape))
-        tank_view_kernel(s.x, s.y, s.heading, s.velocity, s.energy, s.gun_heat, s.alive, team_b, self._memory,
-                         s.scan_time, s.time.astype(np.float64), self.field[0], self.field[1], tank.enemy_slots,
-                         tank.mate_slots, self._mates, self._mates_ok, view, self._slots)
-        self._mask_views(view, self._slots)
-        return target, disc, view
+        shape = (self.n_battles, self.n_robots)
+        target, disc = np.empty(shape, np.int64), np.empty(shape, np.int64)
+        feats = np.empty(shape + (self.n_features,), np.float32)
+        # the same (contiguous) array types as for a step's reset rows: one compiled version of each kernel
+        self._observe_rows(np.arange(self.n_battles), target, disc, feats)
+        return target, disc, feats
 
     def _mask_views(self, view: np.ndarray, slots: np.ndarray) -> None:
         """Zero the tank views (no slots) of the robots not in ``view_robots``, as the kernel leaves them."""

@@ -13,11 +13,12 @@ constant everywhere) four modes, interleaved and repeated (the order rotates eac
 - ``bridge 1``: the Python twin decides every turn, gun and radar included (no controller in Java);
 - ``acting T``: the robots play the same Q table themselves (``run_bridged_battle(acting=...)``: their own copy
   of the policy, first maximum as PolicyBot) and send each observation with the move taken; Python takes it in
-  (the twin checks the move: ``mismatches``) and acknowledges it, and a robot waits only when ``--max-lag``
+  (the twin checks the move: ``mismatches``) and acknowledges it, and a robot waits only when ``--acting-lag``
   observations are unacknowledged: again the same battle as ``java``;
 - ``learn T`` / ``learn T acting``: a learning SSAQ tank (``LearnerPolicy`` around a fresh ``TabularQ``,
   Boltzmann exploration, each SMDP step learned at once), deciding in Python (one round trip per decision) or
-  acting from its own copy of the Q table that every update reaches (``LearnerPolicy.bridge_kwargs()``);
+  acting from its own copy of the Q table that every update reaches (``LearnerPolicy.bridge_kwargs()``, waiting
+  at ``--max-lag`` unacknowledged observations);
   learning changes the battle, so its turns differ from ``java``'s.
 T is the configs' ``arena.decision_turns`` (10). Bridge cost = 1 - bridged turns/s / reference turns/s,
 per repetition (neighbouring runs, similar machine load), excluding the round-start wait; the wait is
@@ -25,7 +26,7 @@ reported on its own. "excl. policy" also leaves out the time spent inside the Py
 Java policy would cost instead is in the ``java`` row). Goal of issue 5: cost <= 25%.
 
 Usage: python benchmarks/bridge_throughput.py [--rounds 10] [--repeats 3] [--cpu-ms 100] [--lead 5]
-       [--max-lag 1] [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--json FILE]
+       [--max-lag 1] [--acting-lag 8] [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--json FILE]
 """
 
 from __future__ import annotations
@@ -91,7 +92,8 @@ class _Checked:
 
 
 def _runner(mode: str, size: int, rounds: int, opts: EngineOptions, policy: ExportedPolicy, exported: Path,
-            every: int, lead: int, max_lag: int, seed: int) -> Callable[[], tuple[EngineRun, BridgedRun | None]]:
+            every: int, lead: int, max_lag: int, acting_lag: int,
+            seed: int) -> Callable[[], tuple[EngineRun, BridgedRun | None]]:
     def run() -> tuple[EngineRun, BridgedRun | None]:
         if mode == "sample":
             return run_battle(_spec(size, STAND_IN, rounds), opts), None
@@ -103,7 +105,7 @@ def _runner(mode: str, size: int, rounds: int, opts: EngineOptions, policy: Expo
         elif mode == "acting T":
             checked = _Checked(policy)
             br = run_bridged_battle(_spec(size, BRIDGE_BOT, rounds), checked, opts, every=every,
-                                    controller=policy.control, acting=policy.robot_acting(max_lag))
+                                    controller=policy.control, acting=policy.robot_acting(acting_lag))
             run.mismatches = checked.mismatches  # type: ignore[attr-defined]
         elif mode in ("learn T", "learn T acting"):
             learner = LearnerPolicy(TabularQ(), np.random.default_rng(seed), train=True, step_turns=every,
@@ -190,7 +192,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--every", type=int, default=ArenaSection().decision_turns, help="T: turns per decision")
     ap.add_argument("--lead", type=int, default=5, help="turns ahead for the 'bridge T lead' mode")
-    ap.add_argument("--max-lag", type=int, default=1, help="unacknowledged observations before an acting robot waits")
+    ap.add_argument("--max-lag", type=int, default=1, help="unacknowledged observations before a learning robot waits")
+    ap.add_argument("--acting-lag", type=int, default=8, help="the same for the robots playing the fixed twin")
     ap.add_argument("--battles", default="1v1,4v4")
     ap.add_argument("--modes", default=",".join(MODES))
     ap.add_argument("--check-rounds", type=int, default=0, help="also a bridged 1v1 of this many rounds")
@@ -215,7 +218,7 @@ def main() -> None:
                 for mode in order:
                     t0 = time.perf_counter()
                     runner = _runner(mode, sizes[battle], args.rounds, opts, policy, exported, args.every,
-                                     args.lead, args.max_lag, args.seed + rep)
+                                     args.lead, args.max_lag, args.acting_lag, args.seed + rep)
                     run, br = runner()
                     rec = _record(battle, mode, rep, run, time.perf_counter() - t0, br)
                     rec["mismatches"] = runner.mismatches  # type: ignore[attr-defined]

@@ -199,9 +199,10 @@ class ExportedPolicy:
                                 obs.gun_heat, obs.energy, t.x, t.y, np.True_, self.control)
         return (float(gun), float(radar), float(power))
 
-    def robot_acting(self, max_lag: int = 2) -> RobotActing:
+    def robot_acting(self, max_lag: int = 8) -> RobotActing:
         """Bridge settings for robots that play this (fixed) Q table themselves, first maximum as PolicyBot:
-        ``run_bridged_battle(..., every=step_turns, controller=control, acting=policy.robot_acting())``."""
+        ``run_bridged_battle(..., every=step_turns, controller=control, acting=policy.robot_acting())``. The
+        table never changes, so ``max_lag`` only bounds what a robot sends ahead of a stalled Python side."""
         if self.kind != "qtable":
             raise ValueError("robots act themselves from a Q table only")
         text = self.to_text()

@@ -62,10 +62,13 @@ with ``order="engine"``, every random processing order exactly as the engine dra
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from functools import cache
+from typing import Any
 
 import numpy as np
 
@@ -84,6 +87,27 @@ _PARALLEL_MIN_BATTLES = 16
 def _pool(workers: int) -> ThreadPoolExecutor:
     """Shared worker threads for the GIL-free kernel."""
     return ThreadPoolExecutor(max_workers=workers, thread_name_prefix="arena")
+
+
+def run_parallel(executor: ThreadPoolExecutor, fn: Callable[..., Any], calls: Sequence[tuple[Any, ...]],
+                 workers: int) -> list[Any]:
+    """``[fn(*c) for c in calls]``, run by this thread and up to ``workers - 1`` of the executor's threads,
+    each taking the next call from the one list (``fn`` must release the GIL, as the compiled kernels do):
+    one hand-over per use, and the calling thread works instead of waiting."""
+    out: list[Any] = [None] * len(calls)
+    order = itertools.count()
+
+    def drain() -> None:
+        while (i := next(order)) < len(calls):
+            out[i] = fn(*calls[i])
+
+    helpers = [executor.submit(drain) for _ in range(min(workers, len(calls)) - 1)]
+    try:
+        drain()
+    finally:
+        for f in helpers:
+            f.result()
+    return out
 
 
 def default_threads() -> int:
@@ -195,9 +219,8 @@ class Arena:
         b, workers = self.n_battles, self.threads
         if b >= _PARALLEL_MIN_BATTLES and workers > 1:
             size = -(-b // workers)
-            futures = [_pool(workers).submit(K.step_range, lo, min(b, lo + size), *args) for lo in range(0, b, size)]
-            for f in futures:
-                f.result()
+            run_parallel(_pool(workers), K.step_range, [(lo, min(b, lo + size), *args) for lo in range(0, b, size)],
+                         workers)
         else:
             K.step_range(0, b, *args)
 

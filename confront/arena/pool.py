@@ -17,11 +17,11 @@ snapshot of the policy) get their actions from the entry's ``policy(discrete (n,
 from __future__ import annotations
 
 from collections.abc import Callable
-from concurrent.futures import Future
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .core import run_parallel
 from .smdp import LEARNER, SMDPConfig, StepResult, TeamBattleEnv, _pool, _smdp_turns
 
 __all__ = ["PoolEntry", "PoolEnv", "PoolStep", "OpponentPolicy"]
@@ -112,8 +112,7 @@ class PoolEnv:
     def step(self, actions: np.ndarray) -> PoolStep:
         """Every env one SMDP step with the agents' ``actions`` (N,).
 
-        The entries' compiled kernels run together on the thread pool (largest first); each entry's results
-        are gathered as soon as its kernels are done, while the others still run."""
+        The entries' compiled kernels run together, largest first, on this thread and the pool's others."""
         a = np.asarray(actions, dtype=np.int64)
         if a.shape != (self.n_agents,):
             raise ValueError(f"actions must have shape ({self.n_agents},), got {a.shape}")
@@ -151,7 +150,7 @@ class PoolEnv:
                         rounds)
 
     def _step_together(self, full_actions: list[np.ndarray]) -> list[StepResult]:
-        """Every env's step (what ``env.step`` does) with all the kernels submitted at once."""
+        """Every env's step (what ``env.step`` does) with all the kernels run together, largest first."""
         begun = [env._begin(full) for env, full in zip(self.envs, full_actions, strict=True)]
         workers = _pool()._max_workers
         whole = len(self.envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
@@ -159,19 +158,8 @@ class PoolEnv:
         for k, (env, (rewards, _, obs)) in enumerate(zip(self.envs, begun, strict=True)):
             calls.extend((k, c) for c in env._kernel_calls(0, env.turns_per_step, rewards, obs, whole=whole))
         calls.sort(key=lambda kc: -(kc[1][1] - kc[1][0]) * self.envs[kc[0]].n_robots)  # largest first
-        futures: list[list[Future]] = [[] for _ in self.envs]
-        if workers == 1:
-            for _, c in calls:
-                _smdp_turns(*c)
-        else:
-            for k, c in calls:
-                futures[k].append(_pool().submit(_smdp_turns, *c))
-        results = []
-        for env, fs, (rewards, active, obs) in zip(self.envs, futures, begun, strict=True):
-            for f in fs:
-                f.result()
-            results.append(env._finish(rewards, active, obs))
-        return results
+        run_parallel(_pool(), _smdp_turns, [c for _, c in calls], workers)
+        return [env._finish(rewards, active, obs) for env, (rewards, active, obs) in zip(self.envs, begun, strict=True)]
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """Every env's state and the last observations (data only)."""

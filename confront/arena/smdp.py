@@ -44,7 +44,7 @@ import numpy as np
 
 from .bots import BOT_NAMES, ScriptedBots
 from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
-from .core import Arena
+from .core import Arena, run_parallel
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
@@ -407,8 +407,7 @@ class TeamBattleEnv:
         calls = self._kernel_calls(t0, t1, rewards, obs)
         if len(calls) == 1:
             return _smdp_turns(*calls[0])
-        futures = [_pool().submit(_smdp_turns, *c) for c in calls]
-        return min(f.result() for f in futures)
+        return min(run_parallel(_pool(), _smdp_turns, calls, len(calls)))
 
     def _finish(self, rewards: np.ndarray, active: np.ndarray, obs: tuple[np.ndarray, ...]) -> StepResult:
         s = self.arena.state.arrays

@@ -156,9 +156,12 @@ def test_history_brings_every_turn_between_decisions(install, lead: int) -> None
     for hs in records.values():
         times = [h.time for h in hs]
         assert times[0] == 0 and all(b > a for a, b in zip(times, times[1:], strict=False))
-        if not res.run.skipped_turns:  # every turn exactly once; a turn skipped just before a robot's death
-            # goes unreported (a dead robot's output is not collected), hence a possible gap before the last
-            assert times[:-1] == list(range(len(times) - 1)) and times[-1] - times[-2] in (1, 2)
+        if not res.run.skipped_turns:  # every turn exactly once; turns skipped just before a robot's death
+            # go unreported (a dead robot's output is not collected), hence a possible gap before the last record
+            # of a robot that died (energy 0): on a loaded machine a robot waiting for a late answer can lose
+            # several turns in a row and be killed meanwhile (seen: 9 turns at load 9, before and after issue 11)
+            assert times[:-1] == list(range(len(times) - 1))
+            assert times[-1] - times[-2] in (1, 2) or hs[-1].energy == 0.0, (times[-3:], hs[-1])
         assert hs[0].energy == 100.0 and hs[0].target == ""  # nothing scanned before turn 1
         assert hs[20].target == "sample.SpinBot"  # scanned within 20 turns: the only enemy
         assert {h.target for h in hs} == {"", "sample.SpinBot"}

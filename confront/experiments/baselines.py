@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
-from confront.experiments.reproduce import Claim, Job, Outcome, run_jobs, slug
+from confront.experiments.jobs import Claim, Job, Outcome, run_jobs, slug
 from confront.experiments.stats import Interval, interval
 from confront.learning.base import Learner, Transition
 from confront.learning.uniform import UniformParams, UniformPolicy
@@ -288,8 +288,8 @@ def _pooled_ratio(rows: Sequence[dict[str, Any]], flip: bool = False) -> tuple[f
 def _evaluate(cfg: BaselinesConfig, exp: Any, seed: int, td_path: Path, policy: Learner | None = None,
               scripted: str = "") -> list[dict[str, Any]]:
     """Score rows of one method (a policy, or a scripted robot as our team) against every opponent."""
+    from confront.experiments.episodes import load_model
     from confront.experiments.evaluate import sim_bot_battle, sim_evaluate
-    from confront.experiments.train import load_model
 
     if (policy is None) == (not scripted):
         raise ValueError("evaluate either a policy or a scripted robot")
@@ -318,7 +318,7 @@ def train_sb3(algo: str, cfg: BaselinesConfig, seed: int, rounds: int) -> tuple[
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.logger import Logger
 
-    from confront.experiments.train import scenario_of, smdp_config, td_team
+    from confront.experiments.episodes import scenario_of, smdp_config, td_team
 
     if algo not in SB3_METHODS:
         raise ValueError(f"algo must be one of {', '.join(SB3_METHODS)}, got {algo!r}")
@@ -359,7 +359,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
     import io
 
     from confront import checkpoint as ck
-    from confront.experiments.train import load_model, td_team
+    from confront.experiments.episodes import load_model, td_team
 
     done = folder / "result.json"
     if done.exists():
@@ -385,7 +385,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
         td_path = Path(summary["td_model"])
         extra.update(train_rounds=int(summary["rounds"]), train_seconds=float(summary["wall_time_s"]))
     else:
-        from confront.experiments.train import build_learner, smdp_config
+        from confront.experiments.episodes import build_learner, smdp_config
 
         smdp = smdp_config(exp)
         _, td_path = td_team(exp, smdp.n_actions)

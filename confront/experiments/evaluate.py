@@ -13,8 +13,8 @@ import numpy as np
 
 from confront.arena.smdp import TeamBattleEnv
 from confront.config import load_toml
+from confront.experiments.episodes import Loop, Side, load_model, scenario_of, smdp_config
 from confront.experiments.spec import ExperimentConfig, config_from_dict
-from confront.experiments.train import Loop, Side, load_model, scenario_of, smdp_config
 from confront.learning.base import Learner
 from confront.results import BattleResults, ScoreRow
 
@@ -242,26 +242,6 @@ def export_cli(run: Path, out: Path, name: str | None) -> None:
                "(no Python needed to run it)")
 
 
-def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | None = None) -> str | None:
-    """One greedy round of the trained team in a single fresh battle, as replay JSON + GIF + HTML."""
-    from confront.arena import replay as rp
-
-    env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=1,
-                        seed=cfg.train.seed + 1000 if seed is None else seed,
-                        opponents="td" if side.opponent is not None else cfg.opponent.kind,
-                        config=smdp_config(cfg))
-    loop = Loop(env, Side(side.learner, side.ours, side.opponent, side.theirs), seed=cfg.train.seed, learning=False)
-    env.start_recording(0)
-    while loop.rounds_done < 1:
-        loop.step()
-    replay = env.stop_recording()
-    if replay is None:
-        return None
-    out_dir.mkdir(parents=True, exist_ok=True)
-    path = replay.save(out_dir / "last_round.replay.json.gz")
-    rp.write_gif(replay, out_dir / "last_round.gif")
-    rp.write_html(replay, out_dir / "last_round.html", title=f"confront: {cfg.name}")
-    return str(path)
 
 
 def replay_cli(source: Path, out: Path | None) -> None:

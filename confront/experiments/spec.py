@@ -149,7 +149,7 @@ class PPOSection:
     hidden: int = field(128, ge=1, le=4096)
     lr: float = field(2.5e-3, gt=0.0, le=1.0, doc="Adam step (measured: 2.5e-3 learned ~2x faster than 1e-3)")
     rollout_steps: int = field(32, ge=1, le=4096)
-    epochs: int = field(4, ge=1, le=100)
+    epochs: int = field(4, ge=1, le=100, doc="passes over each rollout (the demo uses 2 x 2: docs/learning.md)")
     minibatches: int = field(4, ge=1, le=1024)
     gamma: float = field(0.97, ge=0.0, le=1.0, doc="discount per decision (T turns): a horizon of ~33 decisions")
     gae_lambda: float = field(0.95, ge=0.0, le=1.0)

@@ -42,7 +42,7 @@ from confront.experiments.baselines import (
     train_sb3,
 )
 from confront.experiments.evaluate import sim_evaluate
-from confront.experiments.reproduce import Job, run_jobs
+from confront.experiments.jobs import Job, run_jobs
 from confront.experiments.spec import ExperimentConfig, config_from_dict, load_toml
 from confront.experiments.stats import paired_comparison
 from confront.experiments.tanks import evaluate_tanks, load_tank_model
@@ -74,7 +74,7 @@ def _share(rows: list[dict[str, Any]]) -> float:
 
 def _baseline_policy(method: str, seed: int, work: Path) -> tuple[Learner, ExperimentConfig]:
     """The trained (or, for random moves, built) policy of ``method`` at ``seed``, and its experiment config."""
-    from confront.experiments.train import load_model, smdp_config
+    from confront.experiments.episodes import load_model, smdp_config
     from confront.learning.uniform import UniformParams, UniformPolicy
 
     bcfg = BaselinesConfig()
@@ -121,9 +121,11 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
     return shares
 
 
-def compare(runs: list[Path], out: Path, rounds: int, work: Path) -> dict[str, Any]:
-    """Evaluate PPO tanks and every baseline method per seed and entry; write the report; return the results."""
-    from confront.experiments.train import td_team
+def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str, list[float]] | None = None
+            ) -> dict[str, Any]:
+    """Evaluate PPO tanks and every baseline method per seed and entry; write the report; return the results.
+    ``ours``: PPO tanks' shares per entry (one per run, in order) when already measured (tank_report's)."""
+    from confront.experiments.episodes import td_team
 
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
     seeds = [c.train.seed for c in cfgs]
@@ -131,12 +133,13 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path) -> dict[str, A
         raise ValueError(f"the runs must have distinct training seeds, got {seeds}")
     entries = compare_entries(tuple(cfgs[0].league.opponents))
     shares: dict[str, dict[str, list[float]]] = {m: {e: [] for e in entries} for m in (OURS, *METHODS)}
-    for run, cfg in zip(runs, cfgs, strict=True):
+    for k, (run, cfg) in enumerate(zip(runs, cfgs, strict=True)):
         _, td_path = td_team(cfg, 4)
-        ours = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000 + cfg.train.seed,
-                              opponents=tuple(entries))
+        if ours is None:
+            got_ours = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000 + cfg.train.seed,
+                                      opponents=tuple(entries))
         for e in entries:
-            shares[OURS][e].append(ours[e]["share"])
+            shares[OURS][e].append(ours[e][k] if ours is not None else got_ours[e]["share"])
         for m in METHODS:
             got = method_shares(m, cfg.train.seed, entries, str(td_path), rounds, work)
             for e in entries:

@@ -1,7 +1,8 @@
 """The report of the recommended learner: trained PPO tank runs, evaluated per opponent in the simulator and
 (the exported TankBot, no Python) in the real engine, against the issue's targets.
 
-    python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine]
+    python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine [--unseen]]
+        [--compare WORK]
 
 Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
 simulator share (``--rounds`` rounds, the mean over runs with a t-interval when there are 2 or more), and with
@@ -26,6 +27,10 @@ from confront.runs import Run
 
 # the issue's targets per kind of entry: (share, what)
 TARGETS = {"1v1": 0.90, "4v4": 0.80, "4v4:td": 0.75, "4v4:dodge": 0.65}
+# robots of the Robocode distribution the policy never met in training (the engine's own, no simulator twin
+# needed): does it win by what it learned about tanks rather than about its eight opponents?
+UNSEEN = ("1v1:MyFirstRobot", "1v1:sample.MyFirstJuniorRobot", "1v1:sample.PaintingRobot", "1v1:Target",
+          "1v1:TrackFire", "1v1:VelociRobot", "4v4:TrackFire", "4v4:VelociRobot")
 
 
 def target_of(entry: str) -> float | None:
@@ -85,16 +90,36 @@ def _curves(runs: list[Path], out: Path) -> list[Path]:
     return figs
 
 
-def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int) -> dict[str, Any]:
-    """Evaluate the runs and write the report; return the results."""
+def greedy_shares(run: Path, cfg: Any, rounds: int) -> dict[str, float]:
+    """The run's greedy simulator share per league entry over ``rounds`` rounds (battle seed 10000), kept in
+    ``<run>/eval/greedy-<rounds>.json`` (a model is evaluated once, whichever report asks)."""
+    cache = run / "eval" / f"greedy-{rounds}.json"
+    entries = list(cfg.league.opponents)
+    if cache.is_file():
+        got = json.loads(cache.read_text())
+        if all(e in got for e in entries):
+            return got
+    res = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000)
+    shares = {e: res[e]["share"] for e in entries}
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    cache.write_text(json.dumps(shares, indent=1))
+    return shares
+
+
+def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int, unseen: bool = False,
+           compare_work: Path | None = None, engine_from: Path | None = None) -> dict[str, Any]:
+    """Evaluate the runs and write the report; return the results (``unseen``: also the first run's exported
+    robot in the engine against :data:`UNSEEN`, robots no league entry names; ``compare_work``: also the
+    comparison with the baselines, :mod:`confront.experiments.tank_compare`, trained and cached there;
+    ``engine_from``: the engine rows of an earlier ``results.json`` of the same first run, instead of playing)."""
     out.mkdir(parents=True, exist_ok=True)
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
     entries = list(cfgs[0].league.opponents)
     sim: dict[str, list[float]] = {e: [] for e in entries}
     for run, cfg in zip(runs, cfgs, strict=True):
-        res = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000)
+        res = greedy_shares(run, cfg, rounds)
         for e in entries:
-            sim[e].append(res[e]["share"])
+            sim[e].append(res[e])
     real: dict[str, list[float]] = {}
     if engine:
         from confront.arena.bots import BOT_NAMES
@@ -106,10 +131,30 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
             if opp in BOT_NAMES:
                 real[e] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=k + 1)[1]
                            for k in range(engine_seeds)]
+    unseen_rows = []
+    if engine_from is not None:
+        earlier = json.loads(engine_from.read_text())
+        if earlier["runs"][0] != runs[0].name:
+            raise ValueError(f"{engine_from} is of run {earlier['runs'][0]}, not {runs[0].name}")
+        real = {r["entry"]: r["engine"] for r in earlier["rows"] if r.get("engine")}
+        unseen_rows = earlier.get("unseen", [])
+        engine_seeds = earlier["engine_seeds"]
+    if engine and unseen:
+        for e in UNSEEN:
+            scen, _, opp = e.partition(":")
+            unseen_rows.append({"entry": e, "engine": [evaluate_tank_policy(policy, scen, opp, rounds=rounds,
+                                                                            seed=k + 1)[1]
+                                                       for k in range(engine_seeds)]})
     summaries = [json.loads((r / "summary.json").read_text()) for r in runs]
-    result = {"runs": [r.name for r in runs], "rounds": rounds, "engine_seeds": engine_seeds if engine else 0,
+    result = {"runs": [r.name for r in runs], "rounds": rounds,
+              "engine_seeds": engine_seeds if engine or engine_from is not None else 0,
               "trained": [{k: s[k] for k in ("rounds", "wall_time_s", "decisions")} for s in summaries],
-              "rows": [{"entry": e, "sim": sim[e], "engine": real.get(e), "target": target_of(e)} for e in entries]}
+              "rows": [{"entry": e, "sim": sim[e], "engine": real.get(e), "target": target_of(e)} for e in entries],
+              "unseen": unseen_rows}
+    if compare_work is not None:
+        from confront.experiments.tank_compare import compare, compare_entries
+
+        compare(runs, out, rounds, compare_work, ours={e: sim[e] for e in compare_entries(tuple(entries))})
     (out / "results.json").write_text(json.dumps(result, indent=1))
     _curves(runs, out)
     write_markdown(result, out)
@@ -150,6 +195,15 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
                          f"{sim[0] - em:+.3f} | {t_txt} | {met} |")
         else:
             lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | - | - | - | {t_txt} | |")
+    if result.get("unseen"):
+        lines += ["", f"Robots no league entry names (the exported robot in the engine, {seeds} battles of {rounds} "
+                  "rounds each; no target in the issue):", "", "| opponent | engine (battles) | engine mean |",
+                  "|---|---:|---:|"]
+        lines += [f"| {u['entry']} | {' / '.join(f'{v:.3f}' for v in u['engine'])} | {np.mean(u['engine']):.3f} |"
+                  for u in result["unseen"]]
+    if (out / "compare.md").is_file():
+        lines += ["", "Against the paper's method, SB3 PPO and random moves, paired over the training seeds: "
+                  "[compare.md](compare.md) (`python -m confront.experiments.tank_compare`)."]
     figs = sorted(out.glob("share_vs_*.png"))
     lines += ["", *[f"![{f.stem}]({f.name})" for f in figs], ""]
     path = out / "report.md"
@@ -164,13 +218,19 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=100)
     ap.add_argument("--engine", action="store_true")
     ap.add_argument("--engine-seeds", type=int, default=3)
+    ap.add_argument("--unseen", action="store_true", help="with --engine: also robots no league entry names")
+    ap.add_argument("--compare", type=Path, default=None, metavar="WORK",
+                    help="also compare with the paper's method, SB3 PPO and random moves (baselines cached in WORK)")
+    ap.add_argument("--engine-from", type=Path, default=None, metavar="RESULTS_JSON",
+                    help="take the engine rows from an earlier results.json of the same first run")
     args = ap.parse_args()
     if args.rounds < 1 or args.engine_seeds < 1:
         ap.error("--rounds and --engine-seeds must be at least 1")
     for r in args.runs:
         if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
             ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")
-    res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds)
+    res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds, args.unseen, args.compare,
+                 args.engine_from)
     print((args.out / "report.md").read_text())
     print(json.dumps({"report": str(args.out / "report.md"), "entries": len(res["rows"])}))
 

@@ -166,7 +166,7 @@ def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, pro
 
 def _td_opponent(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - returns an OpponentPolicy
     """The paper's TD team (trained once per seed and cached, as in the paper's experiments), greedy."""
-    from confront.experiments.train import td_team
+    from confront.experiments.episodes import td_team
 
     learner, _ = td_team(cfg, 4, progress=progress)
 

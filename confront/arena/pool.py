@@ -72,8 +72,9 @@ class PoolEnv:
         self.envs = [TeamBattleEnv(e.scenario, n_battles=e.battles, seed=seed * 1000 + k, opponents=e.opponents,
                                    config=config, opponent_actions=e.opponent_actions)  # type: ignore[arg-type]
                      for k, e in enumerate(entries)]
-        for env in self.envs:  # only the caller-driven robots' views are read (a scripted bot's is not)
-            env.view_robots = env.learner.copy()
+        for env in self.envs:  # only the caller-driven robots' views are read (a scripted bot's is not), and
+            env.view_robots = env.learner.copy()  # the paper observations only of the opponents' policies
+            env.paper_robots = env.learner & ((env.team_ids() != 0) | (config.tank is None))
         self.ours = [env.team_ids() == 0 for env in self.envs]
         self.theirs = [env.learner & (env.team_ids() != 0) for env in self.envs]
         sizes = [env.n_battles * int(o.sum()) for env, o in zip(self.envs, self.ours, strict=True)]

@@ -212,6 +212,9 @@ class TeamBattleEnv:
         self._kargs_end = (self.field[0], self.field[1], self._turn_buf)
         # robots whose tank view is computed (a pool sets its caller-driven robots: nobody reads a bot's view)
         self.view_robots = np.ones(r, dtype=np.bool_)
+        # robots whose paper observation (target, discrete state, paper features) is computed; the others get
+        # target -1, state 0, features 0 (a pool sets the robots its opponent policies read)
+        self.paper_robots = np.ones(r, dtype=np.bool_)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -272,6 +275,9 @@ class TeamBattleEnv:
             s.scan_time[rows]
         memory = self._memory[rows]
         t, d, f = observe(x, y, h, e, alive, self.team, self.field, self.config.observation, memory, seen)
+        off = ~self.paper_robots
+        if off.any():  # as the kernel leaves them
+            t[:, off], d[:, off], f[:, off] = -1, 0, 0.0
         target[rows], disc[rows] = t, d
         tank = self.config.tank
         if tank is None:
@@ -396,7 +402,8 @@ class TeamBattleEnv:
                 self._memory, self._sensing)
         tank = self.config.tank
         view = (tank.enemy_slots, tank.mate_slots) if tank is not None else (0, 0)
-        tail = (rewards, self.max_distance, *obs, *view, self._mates, self._mates_ok, self._slots, self.view_robots)
+        tail = (rewards, self.max_distance, *obs, *view, self._mates, self._mates_ok, self._slots, self.view_robots,
+                self.paper_robots)
         ranges = [(0, self.n_battles)] if whole else self._ranges
         return [(lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
                 for k, (lo, hi) in enumerate(ranges)]

@@ -16,7 +16,7 @@ from numba import njit
 
 from . import _kernels as K
 from .bots import bots_step
-from .observe import float_mod, observe_kernel, perceive_row, remember_scans, reward_eq35_scalar, target_of
+from .observe import float_mod, perceive_row, remember_scans, reward_eq35_scalar, robot_observation, target_of
 from .state import HIT_ROBOT_SLOTS
 from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
 
@@ -127,13 +127,14 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
                 placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
                 rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
-                view_mask):
+                view_mask, paper_mask):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
     per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of
     the team's score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
     disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0, of the robots in
-    ``view_mask`` (R,); the others' rows zero, their slots -1). Returns the turn index
+    ``view_mask`` (R,); the others' rows zero, their slots -1; the paper's observations of the robots in
+    ``paper_mask`` (R,), the others' target -1, state and features 0). Returns the turn index
     where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
     run in parallel threads. Each robot picks its target and aims from its own picture
     (observe.perceive_row); after each turn the robots' scans go into ``memory``."""
@@ -230,9 +231,23 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     tg = int(buf[0, b, i])
                     rewards[b, i, t] = reward_eq35_scalar(buf[1, b, i], rf[b, K.E, i], buf[2, b, i],
                                                           rf[b, K.E, tg], guard)
-    r = slice(b0, b1)
-    observe_kernel(rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.E], rb[r, K.ALIVE], ri[r, K.TEAM], memory[r],
-                   scan_time[r], sensing, rule, max_distance, width, height, target[r], disc[r], feats[r])
+    # the paper's observations (observe.observe_kernel) of the robots in paper_mask; the others: target -1,
+    # state 0, features 0
+    row = np.zeros(feats.shape[2])
+    for b in range(b0, b1):
+        for i in range(n):
+            if not paper_mask[i]:
+                target[b, i] = -1
+                disc[b, i] = 0
+                feats[b, i, :] = 0.0
+                continue
+            perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
+                         scan_time[b], sensing, vx, vy, ve, va)
+            tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
+            target[b, i] = tg
+            disc[b, i] = robot_observation(vx, vy, rf[b, K.H], ve, i, tg, max_distance, width, height, row)
+            for q in range(row.shape[0]):
+                feats[b, i, q] = row[q]
     if k_slots > 0:  # the tank views of the robots in view_mask (the others' rows zero, no slots)
         row = np.zeros(view.shape[2])
         for b in range(b0, b1):

@@ -55,7 +55,7 @@ def test_pool_step_equals_each_env_stepped_alone(pick: tuple[int, ...]) -> None:
     assert obs.shape == (pool.n_agents, pool.n_features) and n_rounds > 0
 
 
-def test_pool_computes_views_of_caller_driven_robots_only() -> None:
+def test_pool_computes_observations_only_for_those_read() -> None:
     pool = PoolEnv(_entries(), CONFIG, seed=1)
     pool.reset()
     rng = np.random.default_rng(1)
@@ -65,3 +65,6 @@ def test_pool_computes_views_of_caller_driven_robots_only() -> None:
         assert (env.view_robots == env.learner).all()
         assert not feats[:, ~env.learner].any() and (env.slots[:, ~env.learner] == -1).all()
         assert feats[:, env.learner].any()
+    for env, disc in zip(pool.envs, pool._disc, strict=True):  # paper observations only for the opponents' policies
+        assert (env.paper_robots == (env.learner & (env.team_ids() != 0))).all()
+        assert not disc[:, ~env.paper_robots].any()

@@ -1,6 +1,7 @@
 """PPO tanks against the paper's method, SB3 PPO and random moves, matchup by matchup, paired over training seeds.
 
     python -m confront.experiments.tank_compare RUN [RUN ...] --out docs/results/tanks [--rounds 100]
+    python -m confront.experiments.tank_compare --from-report docs/results/tanks/results.json --out ...
 
 Each RUN is a PPO tanks run (``confront train -c tanks --set train.seed=K``); its seed K is the pairing key.
 For every seed K the other methods are trained as ``confront reproduce baselines`` trains them (the paper's
@@ -158,18 +159,71 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str
     return result
 
 
+def welch_greater(a: list[float], b: list[float]) -> dict[str, float]:
+    """Mean difference a - b, its 95% Welch interval and the one-sided Welch t p (a > b), unpaired."""
+    from scipy import stats
+
+    x, y = np.asarray(a, float), np.asarray(b, float)
+    d = float(x.mean() - y.mean())
+    if x.std() == 0 and y.std() == 0:
+        return {"diff": d, "lo": d, "hi": d, "p": 0.0 if d > 0 else 1.0}
+    t = stats.ttest_ind(x, y, equal_var=False, alternative="greater")
+    ci = stats.ttest_ind(x, y, equal_var=False).confidence_interval(0.95)
+    return {"diff": d, "lo": float(ci.low), "hi": float(ci.high), "p": float(t.pvalue)}
+
+
+def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], rounds: int = 100
+                   ) -> dict[str, Any]:
+    """PPO tanks' greedy shares from a tank_report ``results.json`` (its training seeds) against the baselines
+    trained at ``base_seeds`` (``confront train -c tanks``'s TD team of each seed), unpaired: Welch's t."""
+    from confront.experiments.episodes import td_team
+    from confront.experiments.spec import load_experiment
+
+    rep = json.loads(results.read_text())
+    if rep["rounds"] != rounds:
+        raise ValueError(f"{results} evaluated {rep['rounds']} rounds per entry, this comparison {rounds}")
+    entries = compare_entries(tuple(r["entry"] for r in rep["rows"]))
+    shares: dict[str, dict[str, list[float]]] = {OURS: {r["entry"]: r["sim"] for r in rep["rows"]
+                                                        if r["entry"] in entries}}
+    shares.update({m: {e: [] for e in entries} for m in METHODS})
+    for seed in base_seeds:
+        _, td_path = td_team(load_experiment("tanks", (f"train.seed={seed}",)), 4)
+        for m in METHODS:
+            got = method_shares(m, seed, entries, str(td_path), rounds, work)
+            for e in entries:
+                shares[m][e].append(got[e])
+    tests = {m: {e: welch_greater(shares[OURS][e], shares[m][e]) for e in entries} for m in METHODS}
+    result = {"runs": rep["runs"], "seeds": rep["runs"], "base_seeds": base_seeds, "rounds": rounds,
+              "train_rounds": TRAIN_ROUNDS, "entries": entries, "shares": shares, "tests": tests, "test": "welch"}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "compare.json").write_text(json.dumps(result, indent=1))
+    write_markdown(result, out)
+    return result
+
+
 def write_markdown(result: dict[str, Any], out: Path) -> Path:
     """``compare.md`` from ``compare.json``'s content."""
     seeds, entries, shares, tests = result["seeds"], result["entries"], result["shares"], result["tests"]
     n = len(seeds)
+    if result.get("test") == "welch":
+        how = [f"PPO tanks: training seeds {', '.join(map(str, seeds))} (greedy shares of the report, battle seed "
+               f"10000); the baselines: seeds {', '.join(map(str, result['base_seeds']))}, each trained "
+               f"{result['train_rounds']} rounds against that seed's TD team, as `confront reproduce baselines` "
+               "(battle seed 10000 + seed). Simulator, greedy, "
+               f"{result['rounds']} rounds per entry and seed.",
+               "Cells: mean share over seeds; `vs X`: PPO tanks - X, mean [95% Welch interval], one-sided Welch t p "
+               "(unpaired: the seed sets differ)."]
+    else:
+        how = [f"Training seeds {', '.join(map(str, seeds))} (one PPO tanks run each; the baselines trained "
+               f"{result['train_rounds']} rounds against the same seed's TD team, as `confront reproduce "
+               f"baselines`). Simulator, greedy, {result['rounds']} rounds per entry and seed (battle seed 10000 + "
+               "seed).",
+               f"Cells: mean share over the {n} seeds; `vs X`: PPO tanks - X, mean [95% BCa interval], one-sided "
+               "paired sign-flip permutation p (the smallest possible p with n seeds is 2^-n)."]
     lines = [
         "# PPO tanks against the paper's method, SB3 PPO and random moves",
         "",
-        f"Training seeds {', '.join(map(str, seeds))} (one PPO tanks run each; the baselines trained "
-        f"{result['train_rounds']} rounds against the same seed's TD team, as `confront reproduce baselines`). "
-        f"Simulator, greedy, {result['rounds']} rounds per entry and seed (battle seed 10000 + seed).",
-        f"Cells: mean share over the {n} seeds; `vs X`: PPO tanks - X, mean [95% BCa interval], one-sided paired "
-        "sign-flip permutation p (the smallest possible p with n seeds is 2^-n).",
+        *how,
         "",
         "| entry | " + " | ".join([OURS, *METHODS]) + " | " + " | ".join(f"vs {m}" for m in METHODS) + " |",
         "|---|" + "---:|" * (1 + len(METHODS)) + ":---|" * len(METHODS),
@@ -192,13 +246,22 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("runs", nargs="+", type=Path)
+    ap.add_argument("runs", nargs="*", type=Path)
+    ap.add_argument("--from-report", type=Path, default=None, metavar="RESULTS_JSON",
+                    help="PPO tanks' shares from a tank_report results.json instead of RUNs (unpaired, Welch)")
+    ap.add_argument("--base-seeds", type=int, default=5, help="with --from-report: baseline seeds 0..N-1")
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--rounds", type=int, default=100)
     ap.add_argument("--work", type=Path, default=Path("runs") / "tank-compare")
     args = ap.parse_args()
     if args.rounds < 1:
         ap.error("--rounds must be at least 1")
+    if args.from_report is not None:
+        compare_report(args.from_report, args.out, args.work, list(range(args.base_seeds)), args.rounds)
+        print((args.out / "compare.md").read_text())
+        return
+    if not args.runs:
+        ap.error("give the PPO tanks RUN folders, or --from-report")
     for r in args.runs:
         if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
             ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")

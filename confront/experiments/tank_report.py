@@ -196,13 +196,14 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
         else:
             lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | - | - | - | {t_txt} | |")
     if result.get("unseen"):
-        lines += ["", f"Robots no league entry names (the exported robot in the engine, {seeds} battles of {rounds} "
-                  "rounds each; no target in the issue):", "", "| opponent | engine (battles) | engine mean |",
-                  "|---|---:|---:|"]
+        n_b = len(result["unseen"][0]["engine"])
+        lines += ["", f"Robots no league entry names (the first run's exported robot in the engine, {n_b} battle(s) of "
+                  f"{rounds} rounds each, engine seeds 1..{n_b}; the issue sets no target for them):", "",
+                  "| opponent | engine (battles) | engine mean |", "|---|---:|---:|"]
         lines += [f"| {u['entry']} | {' / '.join(f'{v:.3f}' for v in u['engine'])} | {np.mean(u['engine']):.3f} |"
                   for u in result["unseen"]]
     if (out / "compare.md").is_file():
-        lines += ["", "Against the paper's method, SB3 PPO and random moves, paired over the training seeds: "
+        lines += ["", "Against the paper's method, SB3 PPO and random moves over training seeds, with one-sided tests: "
                   "[compare.md](compare.md) (`python -m confront.experiments.tank_compare`)."]
     figs = sorted(out.glob("share_vs_*.png"))
     lines += ["", *[f"![{f.stem}]({f.name})" for f in figs], ""]

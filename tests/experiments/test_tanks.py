@@ -146,6 +146,17 @@ def test_compare_entries_and_paired_verdicts(tmp_path) -> None:
     assert f"{METHODS[0]} on 1 of 2 entries" in md
 
 
+def test_welch_comparison_hand_computed() -> None:
+    from confront.experiments.tank_compare import welch_greater
+
+    # a = (0.9, 0.92, 0.91), b = (0.5, 0.6, 0.55, 0.52, 0.58): diff 0.36; s_a^2 = 1e-4, s_b^2 = 1.7e-3
+    # se = sqrt(1e-4/3 + 1.7e-3/5) = 0.019322, t = 18.63, Welch df = 4.6: one-sided p ~ 6.5e-6
+    w = welch_greater([0.9, 0.92, 0.91], [0.5, 0.6, 0.55, 0.52, 0.58])
+    assert w["diff"] == pytest.approx(0.36) and w["p"] == pytest.approx(6.53e-6, rel=0.01)
+    assert w["lo"] < 0.36 < w["hi"] and w["hi"] - 0.36 == pytest.approx(0.36 - w["lo"])
+    assert welch_greater([1.0, 1.0], [1.0, 1.0, 1.0])["p"] == 1.0  # a tie at the ceiling is not a win
+
+
 def test_demo_contrast_windows_and_figure(tmp_path) -> None:
     from confront.experiments.demo import _windows, plot_contrast
 

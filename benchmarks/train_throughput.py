@@ -13,10 +13,10 @@ from confront.experiments.spec import load_experiment
 from confront.experiments.tanks import TankTrainer
 
 
-def measure(opponents: list[str], battles: int, updates: int) -> dict[str, float | int | str]:
+def measure(opponents: list[str], battles: int, updates: int, config: str = "tanks") -> dict[str, float | int | str]:
     """Run ``updates`` PPO updates after one warm-up update (compiles kernels); figures over the timed ones."""
-    ov = [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", 'learner.kind="ppo"']
-    trainer = TankTrainer(load_experiment("demo", ov))
+    ov = [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}"]
+    trainer = TankTrainer(load_experiment(config, ov))
     trainer.update()  # warm-up: numba kernels, torch
     d0, t0, c0 = trainer.decisions, time.perf_counter(), time.process_time()
     env = upd = 0.0
@@ -26,7 +26,7 @@ def measure(opponents: list[str], battles: int, updates: int) -> dict[str, float
         upd += row["update_fraction"]
     wall = time.perf_counter() - t0
     n = trainer.decisions - d0
-    return {"league": ",".join(opponents), "agents": trainer.pool.n_agents, "decisions": n,
+    return {"config": config, "league": ",".join(opponents), "agents": trainer.pool.n_agents, "decisions": n,
             "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
             "env_fraction": env / updates, "update_fraction": upd / updates, "wall_s": wall}
 
@@ -40,13 +40,14 @@ def main() -> None:
         measure(["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"], args.battles * 2,
                 args.updates),
         measure(["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"], args.battles, args.updates),
+        measure(["1v1:dodge", "4v4:dodge", "4v4:td", "1v1:SpinBot", "1v1:Walls"], 24, args.updates, "tanks-demo"),
     ]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print("| league | agents | decisions/s | decisions/CPU-s | env | update |")
-    print("|---|---:|---:|---:|---:|---:|")
+    print("| config | league | agents | decisions/s | decisions/CPU-s | env | update |")
+    print("|---|---|---:|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | {r['decisions_per_cpu_s']:,.0f} | "
-              f"{r['env_fraction']:.0%} | {r['update_fraction']:.0%} |")
+        print(f"| {r['config']} | {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | "
+              f"{r['decisions_per_cpu_s']:,.0f} | {r['env_fraction']:.0%} | {r['update_fraction']:.0%} |")
     print(json.dumps({"bench": "train", "load": os.getloadavg()[0], "rows": rows}))
 
 

@@ -276,7 +276,7 @@ def baseline_experiment(cfg: BaselinesConfig, seed: int, rounds: int) -> Any:
                                                       f"train.session_rounds={max(1, min(10, rounds // 2))}"))
 
 
-def _pooled_ratio(rows: Sequence[dict[str, Any]], flip: bool = False) -> tuple[float, float, float]:
+def pooled_ratio(rows: Sequence[dict[str, Any]], flip: bool = False) -> tuple[float, float, float]:
     """(ours, theirs, ratio) summed over rounds; ``flip`` swaps the sides (scripted robots played as team 1)."""
     o = float(sum(r["score_ours"] for r in rows))
     t = float(sum(r["score_theirs"] for r in rows))
@@ -297,10 +297,10 @@ def _evaluate(cfg: BaselinesConfig, exp: Any, seed: int, td_path: Path, policy: 
     for opp in cfg.opponents:
         eval_seed = cfg.eval_seed + seed
         if policy is not None:
-            o, t, r = _pooled_ratio(sim_evaluate(exp, policy, opp, cfg.eval_rounds, eval_seed, str(td_path)))
+            o, t, r = pooled_ratio(sim_evaluate(exp, policy, opp, cfg.eval_rounds, eval_seed, str(td_path)))
         elif opp == "td":  # the TD team plays as team 0 (TeamBattleEnv's learning side), the robot as team 1
             td, _ = load_model(td_path)
-            o, t, r = _pooled_ratio(sim_evaluate(exp, td, scripted, cfg.eval_rounds, eval_seed), flip=True)
+            o, t, r = pooled_ratio(sim_evaluate(exp, td, scripted, cfg.eval_rounds, eval_seed), flip=True)
         else:
             res = sim_bot_battle(exp.arena.scenario, [scripted, opp], cfg.eval_rounds, eval_seed, n_battles=16)
             o = sum(c.total for c in res.contestants if c.name.endswith("team 0"))

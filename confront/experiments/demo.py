@@ -7,7 +7,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
-import numpy as np
 
 from confront.experiments.spec import load_experiment
 from confront.runs import new_run_name
@@ -55,18 +54,6 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
     return summary
 
 
-def _windows(rows: list[dict], size: int) -> tuple[np.ndarray, np.ndarray]:
-    """(rounds so far, pooled score share) per window of ``size`` rounds."""
-    x, y = [], []
-    for i in range(0, len(rows) - size + 1, size):
-        chunk = rows[i:i + size]
-        o = sum(float(r["score_ours"]) for r in chunk)
-        t = sum(float(r["score_theirs"]) for r in chunk)
-        x.append(i + size)
-        y.append(o / (o + t) if o + t else 0.5)
-    return np.asarray(x), np.asarray(y)
-
-
 def plot_contrast(tanks_run: Path, paper_run: Path) -> Path:
     """Score share against the 4v4 TD team per window of rounds: PPO tanks (their ``4v4:td`` rounds) and the
     paper's arm (all its rounds are against the TD team), each against its own rounds played."""
@@ -75,14 +62,16 @@ def plot_contrast(tanks_run: Path, paper_run: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from confront.experiments.tanks import share_windows
     from confront.runs import Run
 
     ours = [r for r in Run(tanks_run).read_table("rounds") if r["opponent"] == "4v4:td"]
     theirs = Run(paper_run).read_table("rounds")
     fig, ax = plt.subplots(figsize=(7, 4), dpi=110)
     for rows, label in ((ours, "PPO tanks (recommended)"), (theirs, "paper's DMNN (FLM, AWM)")):
-        x, y = _windows(rows, max(10, len(rows) // 20))
-        ax.plot(x, y, lw=1.6, marker="o", ms=3, label=f"{label}, {len(rows)} rounds")
+        windows = share_windows(rows, max(10, len(rows) // 20))
+        ax.plot([end for end, _ in windows], [v for _, v in windows], lw=1.6, marker="o", ms=3,
+                label=f"{label}, {len(rows)} rounds")
     ax.axhline(0.5, color="k", lw=0.8, ls=":")
     ax.set_xlabel("rounds played against the 4v4 TD team")
     ax.set_ylabel("score share (training)")

@@ -40,6 +40,7 @@ from confront.experiments.baselines import (
     BaselinesConfig,
     SB3Policy,
     baseline_experiment,
+    pooled_ratio,
     train_sb3,
 )
 from confront.experiments.evaluate import sim_evaluate
@@ -65,12 +66,6 @@ def compare_entries(opponents: tuple[str, ...]) -> list[str]:
         if scen in ("1v1", "4v4") and (opp in BOT_NAMES or (opp == "td" and scen == "4v4")):
             out.append(e)
     return out
-
-
-def _share(rows: list[dict[str, Any]]) -> float:
-    o = sum(float(r["score_ours"]) for r in rows)
-    t = sum(float(r["score_theirs"]) for r in rows)
-    return o / (o + t) if o + t > 0 else 0.5
 
 
 def _baseline_policy(method: str, seed: int, work: Path) -> tuple[Learner, ExperimentConfig]:
@@ -115,7 +110,7 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
         scen, _, opp = e.partition(":")
         cfg = replace(exp, arena=replace(exp.arena, scenario=scen))
         rows = sim_evaluate(cfg, policy, opp, rounds, 10_000 + seed, td_model if opp == "td" else None)
-        shares[e] = _share(rows)
+        shares[e] = pooled_ratio(rows)[2]
     done.parent.mkdir(parents=True, exist_ok=True)
     ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "shares": shares},
                                      indent=1).encode())

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from confront.experiments.spec import config_from_dict, load_toml
-from confront.experiments.tanks import evaluate_tanks, load_tank_model
+from confront.experiments.tanks import evaluate_tanks, load_tank_model, share_windows
 from confront.runs import Run
 
 # the targets per kind of entry: (share, what)
@@ -68,15 +68,9 @@ def _curves(runs: list[Path], out: Path) -> list[Path]:
             rows = Run(run).read_table("rounds")
             for name in sorted({r["opponent"] for r in rows}):
                 sub = [r for r in rows if r["opponent"] == name]
-                w = max(20, len(sub) // 30)
-                xs, ys = [], []
-                for i in range(0, len(sub) - w + 1, w):
-                    chunk = sub[i:i + w]
-                    o = sum(float(r["score_ours"]) for r in chunk)
-                    t = sum(float(r["score_theirs"]) for r in chunk)
-                    xs.append(float(chunk[-1][x_key]))
-                    ys.append(o / (o + t) if o + t else 0.5)
-                ax.plot(xs, ys, label=name, lw=1.2)
+                windows = share_windows(sub, max(20, len(sub) // 30))
+                ax.plot([float(sub[end - 1][x_key]) for end, _ in windows], [v for _, v in windows], label=name,
+                        lw=1.2)
         ax.axhline(0.5, color="k", ls=":", lw=0.8)
         ax.set_xlabel(label)
         ax.set_ylabel("score share (training, sampled actions)")
@@ -227,6 +221,8 @@ def main() -> None:
     args = ap.parse_args()
     if args.rounds < 1 or args.engine_seeds < 1:
         ap.error("--rounds and --engine-seeds must be at least 1")
+    if args.engine_from is not None and args.engine:
+        ap.error("--engine plays the battles, --engine-from reads them: give one")
     for r in args.runs:
         if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
             ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")

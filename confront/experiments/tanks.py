@@ -337,6 +337,17 @@ def share_by_opponent(rows: list[dict[str, Any]]) -> dict[str, float]:
     return {k: v[0] / (v[0] + v[1]) if v[0] + v[1] > 0 else 0.5 for k, v in out.items()}
 
 
+def share_windows(rows: list[dict[str, Any]], size: int) -> list[tuple[int, float]]:
+    """(rounds so far, pooled score share) per consecutive window of ``size`` rounds (a partial last one dropped)."""
+    out = []
+    for end in range(size, len(rows) + 1, size):
+        chunk = rows[end - size:end]
+        o = sum(float(r["score_ours"]) for r in chunk)
+        t = sum(float(r["score_theirs"]) for r in chunk)
+        out.append((end, o / (o + t) if o + t > 0 else 0.5))
+    return out
+
+
 def tank_sessions(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
     """Sessions of ``size`` rounds (in the order rounds ended): pooled score ratio, win rate, wall time."""
     out = []

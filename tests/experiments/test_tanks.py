@@ -158,12 +158,12 @@ def test_welch_comparison_hand_computed() -> None:
 
 
 def test_demo_contrast_windows_and_figure(tmp_path) -> None:
-    from confront.experiments.demo import _windows, plot_contrast
+    from confront.experiments.demo import plot_contrast
+    from confront.experiments.tanks import share_windows
 
     rows = [{"opponent": "4v4:td", "score_ours": 3.0 * (k >= 10), "score_theirs": 1.0} for k in range(20)]
-    x, y = _windows(rows, 10)
-    np.testing.assert_array_equal(x, [10, 20])
-    np.testing.assert_allclose(y, [0.0, 0.75])
+    assert share_windows(rows, 10) == [(10, 0.0), (20, 0.75)]
+    assert share_windows(rows[:19], 10) == [(10, 0.0)]  # a partial last window is dropped
     Run(tmp_path / "tanks").write_table("rounds", rows + [{"opponent": "1v1:SpinBot", "score_ours": 9.0,
                                                           "score_theirs": 0.0}])
     Run(tmp_path / "paper").write_table("rounds", [{"score_ours": 1.0, "score_theirs": 1.0}] * 30)

@@ -159,6 +159,8 @@ class PPOSection:
     max_grad_norm: float = field(0.5, gt=0.0)
     reward_scale: float = field(0.01, gt=0.0, doc="score points -> reward units")
     team_critic: bool = field(True, doc="the critic also sees the mean view of the tank's team (MAPPO-style)")
+    overlap: bool = field(True, doc="update on a second thread while the next rollout is collected (acting one "
+                          "update behind); false: collect, then update")
 
 
 @dataclass
@@ -172,6 +174,8 @@ class LeagueSection:
         doc="SCENARIO:OPPONENT entries: a scripted robot (a team of it), td, random, dodge, strafe, or self "
         "(snapshots)")
     battles: int = field(8, ge=1, le=4096, doc="battles per entry")
+    focus: tuple[str, ...] = field((), doc="entries of opponents that get focus_weight times the battles")
+    focus_weight: int = field(3, ge=1, le=64, doc="battle multiplier of the focus entries")
     snapshot_every: int = field(20, ge=1, doc="updates between self-play snapshots")
     snapshots: int = field(5, ge=1, le=100, doc="snapshots kept; self-play battles sample one per update")
 
@@ -186,6 +190,13 @@ class LeagueSection:
                                  f"{', '.join(SCRIPTED_BOTS)}, td, random, dodge, strafe, self")
         if not self.opponents:
             raise ValueError("league.opponents must not be empty")
+        for e in self.focus:
+            if e not in self.opponents:
+                raise ValueError(f"league.focus entry {e!r} is not one of league.opponents")
+
+    def battles_of(self, entry: str) -> int:
+        """Battles of one entry: ``battles``, times ``focus_weight`` for a focus entry."""
+        return self.battles * (self.focus_weight if entry in self.focus else 1)
 
 
 @dataclass

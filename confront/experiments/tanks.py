@@ -35,7 +35,7 @@ from confront.arena.pool import PoolEntry, PoolEnv, PoolStep
 from confront.arena.smdp import SMDPConfig
 from confront.arena.tank import FEATURE_NAMES, OWN_FEATURES, TankSpace
 from confront.experiments.spec import ExperimentConfig
-from confront.learning.ppo import PPO, PPOConfig, Rollout
+from confront.learning.ppo import PPO, UPDATE_STATS, PPOConfig, Rollout
 from confront.runs import Run
 
 __all__ = ["train_tanks", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
@@ -146,7 +146,7 @@ def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, pro
     entries = []
     for e in cfg.league.opponents:
         scen, _, opp = e.partition(":")
-        n = battles or cfg.league.battles
+        n = battles or cfg.league.battles_of(e)
         if opp == "td":
             if td is None:
                 td = _td_opponent(cfg, progress)
@@ -238,6 +238,7 @@ class TankTrainer:
         self.updates: list[dict[str, Any]] = []
         self.decisions = 0
         self.elapsed = 0.0
+        self.pending: Rollout | None = None  # the last rollout, which the next update() learns from
         self._take_snapshot()
 
     @property
@@ -256,20 +257,41 @@ class TankTrainer:
         return self.ppo.critic_input(obs, self.pool.group, self.pool.n_groups, alive)
 
     def update(self) -> dict[str, Any]:
-        """One rollout of S steps and one PPO update; returns the update's log row."""
+        """One rollout of S steps, and one PPO update on the rollout before it (``ppo.overlap``: the two side by
+        side); returns the update's log row (no losses for the first rollout, which has no update before it)."""
         t0 = time.perf_counter()
         first_row = len(self.rows)
-        c, pool = self.ppo.config, self.pool
         self._pick_snapshot()
+        pending, self.pending = self.pending, None
+        if pending is not None:
+            self.ppo.start_update(pending)
+        buf, t_env = self._collect()
+        t_up = time.perf_counter()
+        stats = self.ppo.finish_update() if pending is not None else dict.fromkeys(UPDATE_STATS, math.nan)
+        self.pending = buf
+        if pending is not None and self.ppo.updates % self.cfg.league.snapshot_every == 0:
+            self._take_snapshot()
+        dt = time.perf_counter() - t0
+        self.elapsed += dt
+        row = {"update": self.ppo.updates, "rounds": self.rounds_done, "decisions": self.decisions,
+               "wall_s": self.elapsed, "decisions_per_s": float(buf.active.sum()) / dt,
+               "env_fraction": t_env / dt, "update_wait_fraction": (time.perf_counter() - t_up) / dt, **stats}
+        for r in self.rows[first_row:]:  # the rounds that ended in this update, at its end
+            r["wall_s"] = self.elapsed
+        self.updates.append(row)
+        return row
+
+    def _collect(self) -> tuple[Rollout, float]:
+        """S steps of every battle with the acting policy: the rollout, and the seconds spent in the env."""
+        c, pool = self.ppo.config, self.pool
         s, n = c.rollout_steps, pool.n_agents
-        crit0 = self._critic(self.obs)
+        crit = self._critic(self.obs)
         buf = Rollout(obs=np.zeros((s, n, self.obs.shape[1]), np.float32),
-                      critic=np.zeros((s, n, crit0.shape[1]), np.float32),
+                      critic=np.zeros((s, n, crit.shape[1]), np.float32),
                       heads=np.zeros((s, n, len(self.ppo.dims)), np.int64), logp=np.zeros((s, n), np.float32),
                       value=np.zeros((s, n), np.float32), reward=np.zeros((s, n)), done=np.zeros((s, n), bool),
                       active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
         t_env = 0.0
-        crit = crit0
         for k in range(s):
             joint, heads, logp, value = self.ppo.act(self.obs, crit)
             te = time.perf_counter()
@@ -283,19 +305,7 @@ class TankTrainer:
             self.obs = st.obs
             crit = self._critic(self.obs)
         buf.last_value = self.ppo.values(crit)
-        t_up = time.perf_counter()
-        stats = self.ppo.update(buf)
-        if self.ppo.updates % self.cfg.league.snapshot_every == 0:
-            self._take_snapshot()
-        dt = time.perf_counter() - t0
-        self.elapsed += dt
-        row = {"update": self.ppo.updates, "rounds": self.rounds_done, "decisions": self.decisions,
-               "wall_s": self.elapsed, "decisions_per_s": float(buf.active.sum()) / dt,
-               "env_fraction": t_env / dt, "update_fraction": (time.perf_counter() - t_up) / dt, **stats}
-        for r in self.rows[first_row:]:  # the rounds that ended in this update, at its end
-            r["wall_s"] = self.elapsed
-        self.updates.append(row)
-        return row
+        return buf, t_env
 
     # checkpoint state
     def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
@@ -304,6 +314,8 @@ class TankTrainer:
         for i, snap in enumerate(self.snapshots):
             arrays.update({f"snap{i}.{k}": v for k, v in snap.items()})
         arrays["obs"] = self.obs
+        if self.pending is not None:
+            arrays.update({f"pending.{k}": v for k, v in asdict(self.pending).items()})
         meta = {"kind": "ppo", "rounds_done": self.rounds_done, "decisions": self.decisions, "rows": self.rows,
                 "updates": self.updates, "elapsed_s": self.elapsed, "snapshots": len(self.snapshots),
                 "pool_rng": ck.rng_state(self.pool.rng)}
@@ -320,6 +332,8 @@ class TankTrainer:
             self.ppo.load_state_dict(sub("ppo."))
             self.snapshots = [sub(f"snap{i}.") for i in range(int(meta["snapshots"]))]
             self.obs = np.asarray(arrays["obs"], dtype=np.float32)
+            pending = sub("pending.")
+            self.pending = Rollout(**pending) if pending else None
             self.rows, self.updates = list(meta["rows"]), list(meta["updates"])
             self.decisions, self.elapsed = int(meta["decisions"]), float(meta["elapsed_s"])
             self.pool.rng = ck.rng_from_state(meta["pool_rng"])
@@ -454,7 +468,7 @@ def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_
     """Greedy play against each league entry for ``rounds`` rounds: share (pooled) and win rate per entry."""
     from dataclasses import replace
 
-    league = replace(cfg.league, opponents=opponents or cfg.league.opponents)
+    league = replace(cfg.league, opponents=opponents or cfg.league.opponents, focus=())
     ecfg = replace(cfg, league=league)
     pool, snap = build_pool(ecfg, seed, battles=battles)
     snap.load(ppo.actor_arrays())
@@ -512,7 +526,7 @@ def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int) 
     cfg = config_from_dict(load_toml(run / "config.toml"))
     entries = league_entries(opponents, cfg)
     try:
-        cfg = replace(cfg, league=replace(cfg.league, opponents=entries))
+        cfg = replace(cfg, league=replace(cfg.league, opponents=entries, focus=()))
     except ValueError as exc:
         raise click.UsageError(str(exc)) from None
     ppo = load_tank_model(run, cfg)

@@ -13,6 +13,12 @@ One update (Schulman et al. 2017; the 37 details of Huang et al. 2022 as in Clea
     (a stream ends where ``done``; steps where an agent was not ``active`` (dead) carry no loss)
     -> E epochs of M minibatches: clipped surrogate, clipped value loss, entropy bonus, grad-norm clip
 
+With ``overlap`` (the default) the update of rollout k runs on a second thread while rollout k + 1 is
+collected, acting with the weights from before that update (a behaviour policy one update behind, as in
+asynchronous PPO; the importance ratio is taken against the logged behaviour probabilities, so the surrogate is
+unchanged): :meth:`start_update`, then :meth:`finish_update`. The schedule does not depend on timing, so a run
+is as deterministic as without it.
+
 Arrays in, arrays out: :meth:`PPO.act` takes (N, F) float32 observations; :meth:`PPO.update` a
 :class:`Rollout`. Parameters, optimiser moments and the sampling generator are data (:meth:`state_dict`),
 so a checkpoint resumes exactly.
@@ -20,13 +26,17 @@ so a checkpoint resumes exactly.
 
 from __future__ import annotations
 
+import copy
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 import torch
 from torch import nn
 
-__all__ = ["PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
+UPDATE_STATS = ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance")
+
+__all__ = ["UPDATE_STATS", "PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
 
 
 @dataclass(frozen=True)
@@ -47,6 +57,7 @@ class PPOConfig:
     reward_scale: float = 0.01  # score points -> reward units
     team_critic: bool = True
     threads: int = 1  # torch threads: 1 beside the simulator's threads (more spin-waits on a busy machine)
+    overlap: bool = True  # update on a second thread while the next rollout is collected (acting one update behind)
 
     def __post_init__(self) -> None:
         for name in ("hidden", "rollout_steps", "epochs", "minibatches"):
@@ -60,6 +71,12 @@ class PPOConfig:
         for name in ("lr", "reward_scale", "max_grad_norm"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"ppo.{name} must be > 0, got {getattr(self, name)!r}")
+
+
+def _done(value: dict[str, float]) -> Future[dict[str, float]]:
+    job: Future[dict[str, float]] = Future()
+    job.set_result(value)
+    return job
 
 
 def _layer(n_in: int, n_out: int, gain: float) -> nn.Linear:
@@ -82,10 +99,18 @@ class ActorCritic(nn.Module):
         n_crit = 2 * n_features if team_critic else n_features
         self.critic = nn.Sequential(_layer(n_crit, hidden, g), nn.Tanh(), _layer(hidden, hidden, g), nn.Tanh(),
                                     _layer(hidden, 1, 1.0))
+        # the heads' logits laid out as (H, max d) through one gather; the padding is masked to -inf
+        width = max(self.dims)
+        starts = np.cumsum((0,) + self.dims[:-1])
+        idx = np.array([[s + min(j, d - 1) for j in range(width)] for s, d in zip(starts, self.dims, strict=True)])
+        self.register_buffer("pad_index", torch.from_numpy(idx.reshape(-1)), persistent=False)
+        self.register_buffer("pad", torch.from_numpy(np.arange(width)[None, :] >= np.array(self.dims)[:, None]),
+                             persistent=False)
 
-    def heads(self, obs: torch.Tensor) -> list[torch.Tensor]:
-        """Per-head log-probabilities (N, d_h)."""
-        return [torch.log_softmax(z, dim=-1) for z in torch.split(self.actor(obs), self.dims, dim=-1)]
+    def log_probs(self, obs: torch.Tensor) -> torch.Tensor:
+        """Per-head log-probabilities (N, H, max d), -inf beyond a head's d choices."""
+        z = self.actor(obs)[:, self.pad_index].view(len(obs), *self.pad.shape)
+        return torch.log_softmax(z.masked_fill(self.pad, -torch.inf), dim=-1)
 
     def value(self, critic_in: torch.Tensor) -> torch.Tensor:
         """V (N,)."""
@@ -93,12 +118,12 @@ class ActorCritic(nn.Module):
 
 
 def team_mean(obs: np.ndarray, group: np.ndarray, n_groups: int, alive: np.ndarray) -> np.ndarray:
-    """(N, F) mean observation of each agent's team (its ``group``), over living agents (all if none lives)."""
+    """(N, F) mean observation of each agent's team (its ``group``, sorted, each of 0..n_groups-1 present), over
+    living agents (all if none lives)."""
     w = alive.astype(np.float64) + 1e-6
-    sums = np.zeros((n_groups, obs.shape[1]))
-    np.add.at(sums, group, obs * w[:, None])
-    tot = np.zeros(n_groups)
-    np.add.at(tot, group, w)
+    starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+    sums = np.add.reduceat(obs * w[:, None], starts, axis=0)
+    tot = np.add.reduceat(w, starts)
     return (sums / tot[:, None])[group].astype(np.float32)
 
 
@@ -156,7 +181,12 @@ class PPO:
         torch.manual_seed(seed)
         self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic)
         self.opt = torch.optim.Adam(self.net.parameters(), lr=self.config.lr, eps=1e-5)
-        self.gen = torch.Generator().manual_seed(seed)
+        self.gen = torch.Generator().manual_seed(seed)  # minibatch order
+        self.act_gen = torch.Generator().manual_seed(seed + 1)  # action sampling (its own stream: acting and
+        # updating may run side by side)
+        self.acting = copy.deepcopy(self.net) if self.config.overlap else self.net  # the behaviour policy
+        self._worker = ThreadPoolExecutor(1, thread_name_prefix="ppo-update") if self.config.overlap else None
+        self._job: Future[dict[str, float]] | None = None
         self.dims = self.net.dims
         self.n_features = n_features
         self.updates = 0
@@ -176,26 +206,52 @@ class PPO:
     def act(self, obs: np.ndarray, critic_in: np.ndarray | None = None, explore: bool = True
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(joint actions (N,), heads (N, H), log-probabilities (N,), values (N,)) for (N, F) observations;
-        greedy (per-head argmax) without ``explore``; values are 0 without ``critic_in``."""
-        o = torch.from_numpy(np.ascontiguousarray(obs, dtype=np.float32))
-        logps = self.net.heads(o)
+        sampled per head (Gumbel-max over the ``act_gen`` stream), or greedy (per-head argmax, ties to the lower
+        index) without ``explore``; values are 0 without ``critic_in``."""
+        lp = self.acting.log_probs(torch.from_numpy(np.ascontiguousarray(obs, dtype=np.float32)))
         if explore:
-            heads = [torch.multinomial(lp.exp(), 1, generator=self.gen).squeeze(1) for lp in logps]
+            u = torch.rand(lp.shape, generator=self.act_gen).clamp_(min=1e-20)
+            h = (lp - (-u.log()).log()).argmax(dim=2)
         else:
-            heads = [lp.argmax(dim=1) for lp in logps]
-        logp = sum(lp.gather(1, h[:, None]).squeeze(1) for lp, h in zip(logps, heads, strict=True))
-        h = torch.stack(heads, dim=1).numpy()
-        value = (self.net.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+            h = lp.argmax(dim=2)
+        logp = lp.gather(2, h[:, :, None]).sum(dim=(1, 2))
+        value = (self.acting.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
                  if critic_in is not None else np.zeros(len(obs), np.float32))
-        return np.ravel_multi_index(tuple(h.T), self.dims), h, logp.numpy(), value  # type: ignore[union-attr]
+        hn = h.numpy()
+        return np.ravel_multi_index(tuple(hn.T), self.dims), hn, logp.numpy(), value
 
     @torch.no_grad()
     def values(self, critic_in: np.ndarray) -> np.ndarray:
         """V of (N, C) critic inputs."""
-        return self.net.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+        return self.acting.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+
+    def start_update(self, ro: Rollout) -> None:
+        """Begin :meth:`update` on ``ro``: on the worker thread with ``overlap`` (acting stays on the current
+        weights until :meth:`finish_update`), else here and now."""
+        if self._worker is None:
+            self._job = _done(self._learn(ro))
+        else:
+            self._job = self._worker.submit(self._learn, ro)
+
+    def finish_update(self) -> dict[str, float]:
+        """Wait for the update :meth:`start_update` began; acting then follows the new weights."""
+        if self._job is None:
+            raise RuntimeError("finish_update without start_update")
+        job, self._job = self._job, None
+        stats = job.result()
+        self._sync_acting()
+        return stats
+
+    def _sync_acting(self) -> None:
+        if self.acting is not self.net:
+            self.acting.load_state_dict(self.net.state_dict())
 
     def update(self, ro: Rollout) -> dict[str, float]:
-        """One PPO update on a rollout; returns the losses, entropy, KL and clip fraction (means)."""
+        """One PPO update on a rollout, here and now; returns the losses, entropy, KL and clip fraction (means)."""
+        self._job = _done(self._learn(ro))
+        return self.finish_update()
+
+    def _learn(self, ro: Rollout) -> dict[str, float]:
         c = self.config
         adv, ret = gae(ro.reward, ro.value.astype(np.float64), ro.done, ro.active, ro.last_value.astype(np.float64),
                        c.gamma, c.gae_lambda)
@@ -217,10 +273,9 @@ class PPO:
             perm = torch.randperm(n, generator=self.gen)
             for start in range(0, n, size):
                 idx = perm[start:start + size]
-                logps = self.net.heads(obs[idx])
-                h = heads[idx]
-                logp = sum(lp.gather(1, h[:, k:k + 1]).squeeze(1) for k, lp in enumerate(logps))
-                entropy = sum(-(lp.exp() * lp).sum(dim=1) for lp in logps).mean()
+                lp = self.net.log_probs(obs[idx])
+                logp = lp.gather(2, heads[idx][:, :, None]).sum(dim=(1, 2))
+                entropy = -(lp.exp() * lp.masked_fill(self.net.pad, 0.0)).sum(dim=(1, 2)).mean()
                 ratio = (logp - old_logp[idx]).exp()
                 a = adv_t[idx]
                 a = (a - a.mean()) / (a.std() + 1e-8) if len(idx) > 1 else a
@@ -268,6 +323,7 @@ class PPO:
                                      f"{tuple(layer.weight.shape)}/{tuple(layer.bias.shape)}")
                 layer.weight.copy_(torch.from_numpy(w.astype(np.float32)))
                 layer.bias.copy_(torch.from_numpy(b.astype(np.float32)))
+        self._sync_acting()
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """Network, Adam moments, sampling generator and update count as arrays."""
@@ -277,6 +333,7 @@ class PPO:
             for k, v in st.items():
                 d[f"opt.{pid}.{k}"] = v.detach().numpy().copy() if torch.is_tensor(v) else np.asarray(v)
         d["gen"] = self.gen.get_state().numpy().copy()
+        d["act_gen"] = self.act_gen.get_state().numpy().copy()
         d["updates"] = np.asarray(self.updates)
         return d
 
@@ -296,4 +353,7 @@ class PPO:
         opt["state"] = state
         self.opt.load_state_dict(opt)
         self.gen.set_state(torch.from_numpy(np.asarray(d["gen"], dtype=np.uint8)))
+        if "act_gen" in d:  # models saved before acting had its own stream keep the seed's
+            self.act_gen.set_state(torch.from_numpy(np.asarray(d["act_gen"], dtype=np.uint8)))
         self.updates = int(d["updates"])
+        self._sync_acting()

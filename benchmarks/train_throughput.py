@@ -13,11 +13,15 @@ from confront.experiments.spec import load_experiment
 from confront.experiments.tanks import TankTrainer
 
 
-def measure(opponents: list[str], battles: int, updates: int, config: str = "tanks") -> dict[str, float | int | str]:
-    """Run ``updates`` PPO updates after one warm-up update (compiles kernels); figures over the timed ones."""
-    ov = [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}"]
+def measure(opponents: list[str], battles: int, updates: int, config: str = "tanks", overlap: bool = True
+            ) -> dict[str, float | int | str]:
+    """Run ``updates`` PPO updates after two warm-up ones (kernels compile; the first has no update before it);
+    figures over the timed ones."""
+    ov = [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", "league.focus=[]",
+          f"ppo.overlap={str(overlap).lower()}"]
     trainer = TankTrainer(load_experiment(config, ov))
     trainer.update()  # warm-up: numba kernels, torch
+    trainer.update()
     d0, t0, c0 = trainer.decisions, time.perf_counter(), time.process_time()
     env = upd = 0.0
     for _ in range(updates):
@@ -26,7 +30,8 @@ def measure(opponents: list[str], battles: int, updates: int, config: str = "tan
         upd += row["update_wait_fraction"]
     wall = time.perf_counter() - t0
     n = trainer.decisions - d0
-    return {"config": config, "league": ",".join(opponents), "agents": trainer.pool.n_agents, "decisions": n,
+    return {"config": config, "overlap": overlap, "league": ",".join(opponents), "agents": trainer.pool.n_agents,
+            "decisions": n,
             "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
             "env_fraction": env / updates, "update_wait_fraction": upd / updates, "wall_s": wall}
 
@@ -36,17 +41,19 @@ def main() -> None:
     ap.add_argument("--updates", type=int, default=5)
     ap.add_argument("--battles", type=int, default=16)
     args = ap.parse_args()
-    rows = [
-        measure(["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"], args.battles * 2,
-                args.updates),
-        measure(["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"], args.battles, args.updates),
-        measure(["1v1:dodge", "4v4:dodge", "4v4:td", "1v1:SpinBot", "1v1:Walls"], 24, args.updates, "tanks-demo"),
-    ]
+    league = ["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"]
+    teams = ["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"]
+    demo = ["1v1:dodge", "4v4:dodge", "4v4:td", "1v1:SpinBot", "1v1:Walls"]
+    rows = []
+    for overlap in (True, False):  # the update beside the next rollout (the default), or after it
+        rows += [measure(league, args.battles * 2, args.updates, overlap=overlap),
+                 measure(teams, args.battles, args.updates, overlap=overlap),
+                 measure(demo, 24, args.updates, "tanks-demo", overlap=overlap)]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print("| config | league | agents | decisions/s | decisions/CPU-s | env | waiting for the update |")
-    print("|---|---|---:|---:|---:|---:|---:|")
+    print("| config | overlap | league | agents | decisions/s | decisions/CPU-s | env | waiting for the update |")
+    print("|---|---|---|---:|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['config']} | {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | "
+        print(f"| {r['config']} | {r['overlap']} | {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | "
               f"{r['decisions_per_cpu_s']:,.0f} | {r['env_fraction']:.0%} | {r['update_wait_fraction']:.0%} |")
     print(json.dumps({"bench": "train", "load": os.getloadavg()[0], "rows": rows}))
 

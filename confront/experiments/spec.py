@@ -159,8 +159,8 @@ class PPOSection:
     max_grad_norm: float = field(0.5, gt=0.0)
     reward_scale: float = field(0.01, gt=0.0, doc="score points -> reward units")
     team_critic: bool = field(True, doc="the critic also sees the mean view of the tank's team (MAPPO-style)")
-    overlap: bool = field(True, doc="update on a second thread while the next rollout is collected (acting one "
-                          "update behind); false: collect, then update")
+    overlap: bool = field(False, doc="update on a second thread while the next rollout is collected (acting one "
+                          "update behind, decoupled PPO); false: collect, then update (docs/learning.md)")
 
 
 @dataclass

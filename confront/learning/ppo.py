@@ -13,10 +13,13 @@ One update (Schulman et al. 2017; the 37 details of Huang et al. 2022 as in Clea
     (a stream ends where ``done``; steps where an agent was not ``active`` (dead) carry no loss)
     -> E epochs of M minibatches: clipped surrogate, clipped value loss, entropy bonus, grad-norm clip
 
-With ``overlap`` (the default) the update of rollout k runs on a second thread while rollout k + 1 is
+With ``overlap`` the update of rollout k runs on a second thread while rollout k + 1 is
 collected, acting with the weights from before that update (a behaviour policy one update behind, as in
-asynchronous PPO; the importance ratio is taken against the logged behaviour probabilities, so the surrogate is
-unchanged): :meth:`start_update`, then :meth:`finish_update`. The schedule does not depend on timing, so a run
+asynchronous PPO): :meth:`start_update`, then :meth:`finish_update`. The update then uses decoupled PPO
+(Hilton et al. 2022, "Batch size-invariance for policy optimization"): the ratio is clipped around the weights
+the update starts from (the proximal policy), each sample weighted by pi_prox / pi_behaviour (truncated at
+``IS_MAX``). Clipping around the behaviour policy instead clipped 38% of the samples and left the policy
+near-uniform (docs/learning.md). The schedule does not depend on timing, so a run
 is as deterministic as without it.
 
 Arrays in, arrays out: :meth:`PPO.act` takes (N, F) float32 observations; :meth:`PPO.update` a
@@ -34,6 +37,7 @@ import numpy as np
 import torch
 from torch import nn
 
+IS_MAX = 2.0  # truncation of the behaviour -> proximal importance weight with ``overlap``
 UPDATE_STATS = ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance")
 
 __all__ = ["UPDATE_STATS", "PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
@@ -57,7 +61,7 @@ class PPOConfig:
     reward_scale: float = 0.01  # score points -> reward units
     team_critic: bool = True
     threads: int = 1  # torch threads: 1 beside the simulator's threads (more spin-waits on a busy machine)
-    overlap: bool = True  # update on a second thread while the next rollout is collected (acting one update behind)
+    overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
 
     def __post_init__(self) -> None:
         for name in ("hidden", "rollout_steps", "epochs", "minibatches"):
@@ -267,6 +271,12 @@ class PPO:
         stats = {"policy_loss": 0.0, "value_loss": 0.0, "entropy": 0.0, "approx_kl": 0.0, "clip_frac": 0.0}
         if n == 0:
             return stats
+        if self.acting is self.net:  # acted with these weights: they are the proximal policy, weights 1
+            prox_logp, weight = old_logp, torch.ones(n)
+        else:  # acted one update behind: clip around the current weights (decoupled PPO, Hilton et al. 2022)
+            with torch.no_grad():
+                prox_logp = self.net.log_probs(obs).gather(2, heads[:, :, None]).sum(dim=(1, 2))
+            weight = (prox_logp - old_logp).exp().clamp(max=IS_MAX)  # behaviour -> proximal, truncated
         size = max(1, n // c.minibatches)
         count = 0
         for _ in range(c.epochs):
@@ -276,10 +286,10 @@ class PPO:
                 lp = self.net.log_probs(obs[idx])
                 logp = lp.gather(2, heads[idx][:, :, None]).sum(dim=(1, 2))
                 entropy = -(lp.exp() * lp.masked_fill(self.net.pad, 0.0)).sum(dim=(1, 2)).mean()
-                ratio = (logp - old_logp[idx]).exp()
+                ratio = (logp - prox_logp[idx]).exp()
                 a = adv_t[idx]
                 a = (a - a.mean()) / (a.std() + 1e-8) if len(idx) > 1 else a
-                pg = torch.max(-a * ratio, -a * ratio.clamp(1 - c.clip, 1 + c.clip)).mean()
+                pg = (weight[idx] * torch.max(-a * ratio, -a * ratio.clamp(1 - c.clip, 1 + c.clip))).mean()
                 v = self.net.value(crit[idx])
                 v_clip = old_v[idx] + (v - old_v[idx]).clamp(-c.clip, c.clip)
                 vl = 0.5 * torch.max((v - ret_t[idx]) ** 2, (v_clip - ret_t[idx]) ** 2).mean()
@@ -289,7 +299,7 @@ class PPO:
                 nn.utils.clip_grad_norm_(self.net.parameters(), c.max_grad_norm)
                 self.opt.step()
                 with torch.no_grad():
-                    lr = logp - old_logp[idx]
+                    lr = logp - prox_logp[idx]
                     stats["approx_kl"] += float(((lr.exp() - 1) - lr).mean())
                     stats["clip_frac"] += float(((ratio - 1).abs() > c.clip).float().mean())
                 stats["policy_loss"] += float(pg.detach())

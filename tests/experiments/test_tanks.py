@@ -81,20 +81,20 @@ def _cfg(tmp_path, opponents: str, **kw: str) -> object:
     return load_experiment("demo", ov)
 
 
-@pytest.mark.parametrize(("overlap", "rounds", "faster"), [("false", 200, 0.85), ("true", 300, 0.85)])
-def test_training_against_sittingduck_learns(tmp_path, overlap: str, rounds: int, faster: float) -> None:
-    # acting one update behind (overlap) learns a little slower per update on this small problem
-    cfg = _cfg(tmp_path, "1v1:SittingDuck", **{"league.battles": "16", "train.rounds": str(rounds), "ppo.lr": "0.002",
+@pytest.mark.parametrize("overlap", ["false", "true"])
+def test_training_against_sittingduck_learns(tmp_path, overlap: str) -> None:
+    # with overlap the tanks act one update behind (decoupled PPO): it must learn about as fast
+    cfg = _cfg(tmp_path, "1v1:SittingDuck", **{"league.battles": "16", "train.rounds": "200", "ppo.lr": "0.002",
                                                 "ppo.overlap": overlap})
     trainer = TankTrainer(cfg)
     before = evaluate_tanks(cfg, trainer.ppo, rounds=8)["1v1:SittingDuck"]
-    while trainer.rounds_done < rounds:
+    while trainer.rounds_done < 200:
         trainer.update()
     after = evaluate_tanks(cfg, trainer.ppo, rounds=8)["1v1:SittingDuck"]
     turns_first = np.mean([r["turns"] for r in trainer.rows[:32]])
     turns_last = np.mean([r["turns"] for r in trainer.rows[-32:]])
     assert after["share"] > 0.9 and after["win_rate"] == 1.0
-    assert turns_last < faster * turns_first  # it learned to destroy the sitting duck sooner
+    assert turns_last < 0.85 * turns_first  # it learned to destroy the sitting duck sooner
     assert before["win_rate"] <= after["win_rate"]
 
 

@@ -94,3 +94,26 @@ def test_bad_state_and_config_refused() -> None:
         a.load_state_dict(PPO(3, (2, 3), PPOConfig(hidden=8)).state_dict())
     with pytest.raises(ValueError, match="ppo.rollout_steps"):
         PPOConfig(rollout_steps=0)
+
+
+def test_overlap_acts_one_update_behind_and_stays_deterministic() -> None:
+    obs = np.random.default_rng(2).standard_normal((64, 2)).astype(np.float32)
+    runs = []
+    for _ in range(2):
+        rng = np.random.default_rng(4)
+        ppo = PPO(2, (2, 3), PPOConfig(hidden=8, team_critic=False, lr=1e-2, overlap=True), seed=5)
+        assert ppo.acting is not ppo.net
+        ppo.update(_bandit_rollout(ppo, rng))  # the synchronous form: acting follows at once
+        before = ppo.act(obs, explore=False)[1]
+        ppo.start_update(_bandit_rollout(ppo, rng))
+        during = ppo.act(obs, explore=False)[1]  # the update runs on the worker; acting keeps the old weights
+        stats = ppo.finish_update()
+        assert np.isfinite(stats["policy_loss"]) and 0.0 <= stats["clip_frac"] <= 1.0
+        np.testing.assert_array_equal(before, during)
+        for a, b in zip(ppo.acting.state_dict().values(), ppo.net.state_dict().values(), strict=True):
+            np.testing.assert_array_equal(a.numpy(), b.numpy())
+        runs.append(ppo.state_dict())
+    for k, v in runs[0].items():  # thread timing does not enter the results
+        np.testing.assert_array_equal(v, runs[1][k], err_msg=k)
+    with pytest.raises(RuntimeError, match="without start_update"):
+        PPO(2, (2, 3), PPOConfig(hidden=8)).finish_update()

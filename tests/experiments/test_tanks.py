@@ -98,8 +98,10 @@ def test_training_against_sittingduck_learns(tmp_path, overlap: str) -> None:
     assert before["win_rate"] <= after["win_rate"]
 
 
-def test_resume_after_a_kill_is_exact(tmp_path) -> None:
-    cfg = _cfg(tmp_path, "1v1:SpinBot,4v4:dodge", ckpt="6", **{"league.battles": "2", "train.rounds": "14"})
+@pytest.mark.parametrize("overlap", ["false", "true"])
+def test_resume_after_a_kill_is_exact(tmp_path, overlap: str) -> None:
+    cfg = _cfg(tmp_path, "1v1:SpinBot,4v4:dodge", ckpt="6", **{"league.battles": "2", "train.rounds": "14",
+                                                              "ppo.overlap": overlap})
     full = train_tanks(cfg, Run.create(tmp_path / "full", {}), progress=False)
     part = Run.create(tmp_path / "part", {})
     trainer = TankTrainer(cfg)

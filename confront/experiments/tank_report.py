@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from confront import checkpoint as ck
 from confront.experiments.spec import config_from_dict, load_toml
 from confront.experiments.tanks import evaluate_tanks, load_tank_model, share_windows
 from confront.runs import Run
@@ -84,6 +85,22 @@ def _curves(runs: list[Path], out: Path) -> list[Path]:
     return figs
 
 
+def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int) -> float:
+    """The exported robot's score share in one Robocode battle of ``rounds`` rounds (engine ``seed``), kept in
+    ``<run>/eval/engine-<rounds>.json`` as soon as it is played (a long report that dies keeps its battles)."""
+    from confront.engine.tank_export import evaluate_tank_policy
+
+    cache = run / "eval" / f"engine-{rounds}.json"
+    got = json.loads(cache.read_text()) if cache.is_file() else {}
+    key = f"{entry}@{seed}"
+    if key not in got:
+        scen, _, opp = entry.partition(":")
+        got[key] = evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed)[1]
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        ck.write_atomic(cache, json.dumps(got, indent=1).encode())
+    return float(got[key])
+
+
 def greedy_shares(run: Path, cfg: Any, rounds: int) -> dict[str, float]:
     """The run's greedy simulator share per league entry over ``rounds`` rounds (battle seed 10000), kept in
     ``<run>/eval/greedy-<rounds>.json`` (a model is evaluated once, whichever report asks)."""
@@ -117,14 +134,12 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
     real: dict[str, list[float]] = {}
     if engine:
         from confront.arena.bots import BOT_NAMES
-        from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
+        from confront.engine.tank_export import load_tank_policy
 
         policy = load_tank_policy(runs[0])
         for e in entries:
-            scen, _, opp = e.partition(":")
-            if opp in BOT_NAMES:
-                real[e] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=k + 1)[1]
-                           for k in range(engine_seeds)]
+            if e.partition(":")[2] in BOT_NAMES:
+                real[e] = [engine_share(runs[0], policy, e, rounds, k + 1) for k in range(engine_seeds)]
     unseen_rows = []
     if engine_from is not None:
         earlier = json.loads(engine_from.read_text())
@@ -135,9 +150,7 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
         engine_seeds = earlier["engine_seeds"]
     if engine and unseen:
         for e in UNSEEN:
-            scen, _, opp = e.partition(":")
-            unseen_rows.append({"entry": e, "engine": [evaluate_tank_policy(policy, scen, opp, rounds=rounds,
-                                                                            seed=k + 1)[1]
+            unseen_rows.append({"entry": e, "engine": [engine_share(runs[0], policy, e, rounds, k + 1)
                                                        for k in range(engine_seeds)]})
     summaries = [json.loads((r / "summary.json").read_text()) for r in runs]
     result = {"runs": [r.name for r in runs], "rounds": rounds,

@@ -424,3 +424,14 @@ def test_twin_acts_like_the_ppo_learner(views) -> None:
         close += near
         assert near or policy.act(v) == int(a)
     assert close < len(obs) // 100 and len(set(joint.tolist())) > 10
+
+
+@pytest.mark.engine
+def test_report_keeps_each_engine_battle(install, tmp_path) -> None:
+    from confront.experiments.tank_report import engine_share
+
+    share = engine_share(tmp_path, _policy(7), "1v1:SittingDuck", 1, 1)
+    cache = tmp_path / "eval" / "engine-1.json"
+    assert json.loads(cache.read_text()) == {"1v1:SittingDuck@1": share} and 0.0 <= share <= 1.0
+    cache.write_text(json.dumps({"1v1:SittingDuck@1": 0.123}))
+    assert engine_share(tmp_path, _policy(7), "1v1:SittingDuck", 1, 1) == 0.123  # read back, not played again

@@ -172,7 +172,7 @@ def torchrl(decisions: int, hidden: int, battles: int, rounds: int) -> dict[str,
     class Heads(Distribution):
         """Independent categoricals over the action heads' logits (the MultiDiscrete of the other rows)."""
 
-        arg_constraints: dict = {}  # noqa: RUF012
+        arg_constraints: dict = {}
 
         def __init__(self, logits: torch.Tensor) -> None:
             self.heads = [Categorical(logits=z) for z in logits.split(list(dims), dim=-1)]

@@ -753,32 +753,16 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
 @njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-              ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots=None, heat=None):
+              ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, heat):
     """One decision of every scripted robot (their robot time between two turns).
 
-    ``hit_robots``: the arena's per-collision HitRobot rows (``rf[:, EVROBN:EVROBN + 1 + 4 * HIT_ROBOT_SLOTS]``),
-    else one HitRobotEvent per robot and turn (the last); ``heat``: the gun heats (TrackFire reads them), else 0.
+    ``hit_robots``: the arena's per-collision HitRobot rows (``rf[:, EVROBN:EVROBN + 1 + 4 * HIT_ROBOT_SLOTS]``);
+    ``heat``: the gun heats (TrackFire reads them). One call signature only: each variant is a compile.
     """
     for b in range(x.shape[0]):
-        if hit_robots is None:
-            if heat is None:
-                _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
-                             radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing,
-                             ev_fault, ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, mem, False,
-                             assist)
-            else:
-                _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
-                             radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing,
-                             ev_fault, ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, mem, False,
-                             heat)
-        elif heat is None:
-            _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
-                         radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-                         ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, assist)
-        else:
-            _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
-                         radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-                         ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, heat)
+        _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
+                     radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
+                     ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, heat)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")

@@ -511,7 +511,7 @@ def _add_message(mem, b, d, time, px, py):
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
 def _head(mem, b, i):
     """Index of the first queued event in Robocode's order (-1: empty)."""
-    best = -1
+    best = np.int64(-1)  # not a literal -1: _dispatch(k) is then compiled once, for int64
     for k in range(int(mem[b, i, M_NEV])):
         if mem[b, i, M_EVQ + k * E_SIZE + E_TIME] > mem[b, i, M_CLOCK]:
             continue  # a team message sent this turn: delivered in the next one

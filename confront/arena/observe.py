@@ -75,6 +75,18 @@ class ObservationConfig:
         return 9 if self.include_position else 7
 
 
+def kernel_array(a: np.ndarray, dtype: type) -> np.ndarray:
+    """``a`` as a writable C-contiguous array of ``dtype`` (a copy only when needed): numba compiles a kernel
+    once per array type (layout, dtype, read-only flag), so every Python entry point passes this one."""
+    a = np.ascontiguousarray(a, dtype=dtype)
+    return a if a.flags.writeable else a.copy()
+
+
+def team_rows(team: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """Team ids (R,) or (B, R) as a (B, R) kernel array of the arena's dtype (int32, as the SMDP kernel's)."""
+    return np.array(np.broadcast_to(team, shape), dtype=np.int32, order="C")
+
+
 @njit(cache=True)
 def float_mod(a: float, m: float) -> float:
     """a mod m for m > 0 with the sign of m, computed exactly as Python's and NumPy's float % (fmod based)."""
@@ -140,10 +152,8 @@ def select_targets(
     if rule not in TARGET_RULES:
         raise ValueError(f"target rule must be 'nearest' or 'weakest', got {rule!r}")
     out = np.empty(x.shape, dtype=np.int64)
-    team_b = np.ascontiguousarray(np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape))
-    _targets_kernel(np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64),
-                    np.ascontiguousarray(energy, dtype=np.float64), np.ascontiguousarray(alive, dtype=np.bool_),
-                    team_b, TARGET_RULES[rule], out)
+    _targets_kernel(kernel_array(x, np.float64), kernel_array(y, np.float64), kernel_array(energy, np.float64),
+                    kernel_array(alive, np.bool_), team_rows(team, x.shape), TARGET_RULES[rule], out)
     return out
 
 
@@ -330,11 +340,9 @@ def perceive(x: np.ndarray, y: np.ndarray, energy: np.ndarray, alive: np.ndarray
             raise ValueError("sensing='scanned' needs the scan memory and the scan times")
         memory, seen = np.zeros((b, 3, r, r)), np.zeros((b, r, r), dtype=np.int32)
     out = tuple(np.empty((b, r, r)) for _ in range(3)) + (np.empty((b, r, r), dtype=np.bool_),)
-    team_b = np.ascontiguousarray(np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape))
-    _perceive_kernel(np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64),
-                     np.ascontiguousarray(energy, dtype=np.float64), np.ascontiguousarray(alive, dtype=np.bool_),
-                     team_b, np.ascontiguousarray(memory, dtype=np.float64), np.ascontiguousarray(seen),
-                     SENSING[sensing], *out)
+    _perceive_kernel(kernel_array(x, np.float64), kernel_array(y, np.float64), kernel_array(energy, np.float64),
+                     kernel_array(alive, np.bool_), team_rows(team, x.shape), kernel_array(memory, np.float64),
+                     kernel_array(seen, np.int32), SENSING[sensing], *out)
     return out  # type: ignore[return-value]
 
 
@@ -406,10 +414,11 @@ def observe(
     target = np.empty(x.shape, dtype=np.int64)
     disc = np.empty(x.shape, dtype=np.int64)
     feats = np.empty(x.shape + (config.n_features,), dtype=np.float32)
-    team_b = np.broadcast_to(np.asarray(team, dtype=np.int64), x.shape)
     sensing = SENSING[config.sensing] if memory is not None and seen is not None else 0
     if memory is None or seen is None:
         memory, seen = np.zeros((b, 3, r, r)), np.zeros((b, r, r), dtype=np.int32)
-    observe_kernel(x, y, heading, energy, alive, team_b, memory, seen, sensing, TARGET_RULES[config.target],
-                   float(dmax), float(field[0]), float(field[1]), target, disc, feats)
+    x, y, heading, energy, memory = (kernel_array(a, np.float64) for a in (x, y, heading, energy, memory))
+    observe_kernel(x, y, heading, energy, kernel_array(alive, np.bool_), team_rows(team, x.shape), memory,
+                   kernel_array(seen, np.int32), sensing, TARGET_RULES[config.target], float(dmax), float(field[0]),
+                   float(field[1]), target, disc, feats)
     return target, disc, feats

@@ -45,7 +45,7 @@ import numpy as np
 from .bots import BOT_NAMES, ScriptedBots
 from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
 from .core import Arena, run_parallel
-from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe
+from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
 from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # noqa: F401 - re-exported
@@ -285,9 +285,8 @@ class TeamBattleEnv:
             return
         view = np.empty(x.shape + (tank.n_features,), np.float32)
         slots = np.empty(x.shape + (tank.enemy_slots,), np.int64)
-        team_b = np.ascontiguousarray(np.broadcast_to(self.team, x.shape))
-        tank_view_kernel(x, y, h, s.velocity[rows], e, s.gun_heat[rows], alive, team_b, memory, seen,
-                         s.time[rows].astype(np.float64), self.field[0], self.field[1], tank.enemy_slots,
+        tank_view_kernel(x, y, h, s.velocity[rows], e, s.gun_heat[rows], alive, team_rows(self.team, x.shape), memory,
+                         seen, s.time[rows].astype(np.float64), self.field[0], self.field[1], tank.enemy_slots,
                          tank.mate_slots, self._mates[rows], self._mates_ok[rows], view, slots)
         self._mask_views(view, slots)
         feats[rows] = view

@@ -186,7 +186,7 @@ def _clear_level(mem, b, i, lv, active):
     mem[b, i, base + LV_START] = 0
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _h(mem, b, i, op, val):
     """Append an operation to the handler being dispatched (the top level)."""
     _push(mem, b, i, _top_level(mem, b, i), op, val)

@@ -48,7 +48,7 @@ from .core import Arena, run_parallel
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
-from .smdp_kernel import _prepare, _relative, _smdp_turns, compile_callees_first, controller_turn  # noqa: F401
+from .smdp_kernel import _prepare, _relative, _smdp_turns, compile_callees_first, controller_turn  # noqa: F401 - re-exported
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
 

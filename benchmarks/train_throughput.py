@@ -50,7 +50,7 @@ def main() -> None:
                  measure(teams, args.battles, args.updates, overlap=overlap),
                  measure(demo, 24, args.updates, "tanks-demo", overlap=overlap)]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print("| config | overlap | league | agents | decisions/s | decisions/CPU-s | env | waiting for the update |")
+    print("| config | overlap | league | agents | decisions/s | decisions/CPU-s | env | update (or waiting for it) |")
     print("|---|---|---|---:|---:|---:|---:|---:|")
     for r in rows:
         print(f"| {r['config']} | {r['overlap']} | {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | "

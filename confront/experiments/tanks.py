@@ -264,10 +264,12 @@ class TankTrainer:
         self._pick_snapshot()
         pending, self.pending = self.pending, None
         if pending is not None:
-            self.ppo.start_update(pending)
+            self.ppo.start_update(pending)  # with overlap it returns at once
+        t_up = time.perf_counter() - t0
         buf, t_env = self._collect()
-        t_up = time.perf_counter()
+        t1 = time.perf_counter()
         stats = self.ppo.finish_update() if pending is not None else dict.fromkeys(UPDATE_STATS, math.nan)
+        t_up += time.perf_counter() - t1
         self.pending = buf
         if pending is not None and self.ppo.updates % self.cfg.league.snapshot_every == 0:
             self._take_snapshot()
@@ -275,7 +277,7 @@ class TankTrainer:
         self.elapsed += dt
         row = {"update": self.ppo.updates, "rounds": self.rounds_done, "decisions": self.decisions,
                "wall_s": self.elapsed, "decisions_per_s": float(buf.active.sum()) / dt,
-               "env_fraction": t_env / dt, "update_wait_fraction": (time.perf_counter() - t_up) / dt, **stats}
+               "env_fraction": t_env / dt, "update_wait_fraction": t_up / dt, **stats}
         for r in self.rows[first_row:]:  # the rounds that ended in this update, at its end
             r["wall_s"] = self.elapsed
         self.updates.append(row)

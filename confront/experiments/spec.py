@@ -155,6 +155,8 @@ class PPOSection:
     gae_lambda: float = field(0.95, ge=0.0, le=1.0)
     clip: float = field(0.2, gt=0.0, le=10.0)
     ent_coef: float = field(0.01, ge=0.0, le=10.0)
+    ent_coef_end: float = field(0.01, ge=0.0, le=10.0, doc="entropy coefficient after ent_anneal_updates")
+    ent_anneal_updates: int = field(0, ge=0, doc="updates over which ent_coef goes linearly to ent_coef_end (0: off)")
     vf_coef: float = field(0.5, ge=0.0, le=100.0)
     max_grad_norm: float = field(0.5, gt=0.0)
     reward_scale: float = field(0.01, gt=0.0, doc="score points -> reward units")

@@ -40,7 +40,7 @@ from torch import nn
 IS_MAX = 2.0  # truncation of the behaviour -> proximal importance weight with ``overlap``
 UPDATE_STATS = ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance")
 
-__all__ = ["UPDATE_STATS", "PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
+__all__ = ["UPDATE_STATS", "entropy_coef", "PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,8 @@ class PPOConfig:
     gae_lambda: float = 0.95
     clip: float = 0.2
     ent_coef: float = 0.01
+    ent_coef_end: float = 0.01  # the entropy coefficient after ent_anneal_updates (linear in between)
+    ent_anneal_updates: int = 0  # 0: ent_coef throughout
     vf_coef: float = 0.5
     max_grad_norm: float = 0.5
     reward_scale: float = 0.01  # score points -> reward units
@@ -64,6 +66,8 @@ class PPOConfig:
     overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:
+            raise ValueError(f"ppo.ent_anneal_updates must be an integer >= 0, got {self.ent_anneal_updates!r}")
         for name in ("hidden", "rollout_steps", "epochs", "minibatches"):
             v = getattr(self, name)
             if not isinstance(v, int) or v < 1:
@@ -75,6 +79,15 @@ class PPOConfig:
         for name in ("lr", "reward_scale", "max_grad_norm"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"ppo.{name} must be > 0, got {getattr(self, name)!r}")
+
+
+def entropy_coef(c: PPOConfig, updates: int) -> float:
+    """The entropy bonus of update number ``updates`` (0-based): ent_coef, linearly to ent_coef_end over
+    ent_anneal_updates updates, then ent_coef_end."""
+    if c.ent_anneal_updates == 0:
+        return c.ent_coef
+    f = min(1.0, updates / c.ent_anneal_updates)
+    return c.ent_coef + f * (c.ent_coef_end - c.ent_coef)
 
 
 def _done(value: dict[str, float]) -> Future[dict[str, float]]:
@@ -279,6 +292,7 @@ class PPO:
             weight = (prox_logp - old_logp).exp().clamp(max=IS_MAX)  # behaviour -> proximal, truncated
         size = max(1, n // c.minibatches)
         count = 0
+        ent_coef = entropy_coef(c, self.updates)
         for _ in range(c.epochs):
             perm = torch.randperm(n, generator=self.gen)
             for start in range(0, n, size):
@@ -293,7 +307,7 @@ class PPO:
                 v = self.net.value(crit[idx])
                 v_clip = old_v[idx] + (v - old_v[idx]).clamp(-c.clip, c.clip)
                 vl = 0.5 * torch.max((v - ret_t[idx]) ** 2, (v_clip - ret_t[idx]) ** 2).mean()
-                loss = pg - c.ent_coef * entropy + c.vf_coef * vl
+                loss = pg - ent_coef * entropy + c.vf_coef * vl
                 self.opt.zero_grad()
                 loss.backward()
                 nn.utils.clip_grad_norm_(self.net.parameters(), c.max_grad_norm)

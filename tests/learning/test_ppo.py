@@ -117,3 +117,14 @@ def test_overlap_acts_one_update_behind_and_stays_deterministic() -> None:
         np.testing.assert_array_equal(v, runs[1][k], err_msg=k)
     with pytest.raises(RuntimeError, match="without start_update"):
         PPO(2, (2, 3), PPOConfig(hidden=8)).finish_update()
+
+
+def test_entropy_coefficient_anneals_linearly() -> None:
+    from confront.learning.ppo import entropy_coef
+
+    c = PPOConfig(ent_coef=0.01, ent_coef_end=0.002, ent_anneal_updates=100)
+    assert entropy_coef(c, 0) == 0.01 and entropy_coef(c, 100) == 0.002 and entropy_coef(c, 500) == 0.002
+    assert entropy_coef(c, 25) == pytest.approx(0.008)
+    assert entropy_coef(PPOConfig(ent_coef=0.03), 10_000) == 0.03  # off by default
+    with pytest.raises(ValueError, match="ent_anneal_updates"):
+        PPOConfig(ent_anneal_updates=-1)

@@ -258,7 +258,8 @@ class TankTrainer:
 
     def update(self) -> dict[str, Any]:
         """One rollout of S steps, and one PPO update on the rollout before it (``ppo.overlap``: the two side by
-        side); returns the update's log row (no losses for the first rollout, which has no update before it)."""
+        side); returns the update's log row (no losses for the first rollout, which has no update before it; a
+        run's last rollout is collected but not learned from)."""
         t0 = time.perf_counter()
         first_row = len(self.rows)
         self._pick_snapshot()

@@ -264,8 +264,8 @@ class PPO:
             self.acting.load_state_dict(self.net.state_dict())
 
     def update(self, ro: Rollout) -> dict[str, float]:
-        """One PPO update on a rollout, here and now; returns the losses, entropy, KL and clip fraction (means)."""
-        self._job = _done(self._learn(ro))
+        """One PPO update on a rollout, waited for; returns the losses, entropy, KL and clip fraction (means)."""
+        self.start_update(ro)
         return self.finish_update()
 
     def _learn(self, ro: Rollout) -> dict[str, float]:

@@ -588,13 +588,13 @@ class BridgeServer:
         thread.start()
 
     def stop(self, drain_s: float = 5.0) -> None:
-        """Stop serving and close every socket. With robots acting themselves, sessions get up to ``drain_s``
-        seconds to take in what their robot sent before it closed its end (such robots do not wait for their
-        last observations and end line to be read)."""
+        """Stop serving and close every socket. Sessions first get up to ``drain_s`` seconds to take in what
+        their robot sent before it closed its end: a robot's last end line may still be unread when the engine
+        exits (robots acting themselves do not even wait for their last observations to be read)."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5)
-        deadline = time.monotonic() + (drain_s if self.settings.acting is not None else 0.0)
+        deadline = time.monotonic() + drain_s
         with self._lock:
             sessions = list(self._sessions)
         for thread in sessions:

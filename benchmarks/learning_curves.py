@@ -70,7 +70,7 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
     SMDP step and their mean distance to the target (px); ``learner_params`` rebuild the DMNN; ``reward`` is what
     the learners are trained on (module docstring)."""
     from confront.experiments.spec import load_experiment
-    from confront.experiments.train import _run, _setup, session_rows, td_learner
+    from confront.experiments.train import SMDPTrainer, run_rounds, session_rows, td_learner
     from confront.learning.factory import clone_learner, make_learner
     from confront.learning.transfer import Frozen
 
@@ -78,7 +78,7 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
     if arm == "ssaq":
         sets.append("learner.kind=ssaq")
     cfg = load_experiment("awm", sets)
-    loop, _ = _setup(cfg, progress=False)
+    loop = SMDPTrainer(cfg).loop
     n_actions = loop.env.n_actions
     if learner_params and arm in ("dmnn", "frozen"):
         lr = loop.side.learner
@@ -126,7 +126,7 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
         return res
 
     loop.env.step = step  # type: ignore[method-assign]
-    _run(loop, rounds, progress=False, desc=arm)
+    run_rounds(loop, rounds, progress=False, desc=arm)
     ratio = np.array([s["score_ratio"] for s in session_rows(loop.rows[:rounds], 10)])
     return np.stack([ratio, reward[0] / np.maximum(reward[1], 1), reward[2] / np.maximum(reward[1], 1)])
 

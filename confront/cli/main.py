@@ -112,21 +112,12 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
         if given:
             raise click.UsageError(f"--resume continues {resume} with its own config and folder: drop "
                                    f"{', '.join(given)} (or start a new run without --resume)")
-    if engine == "robocode":
-        from confront.experiments.train_engine import train_in_engine
-
-        if resume is not None:
-            print_summary(train_in_engine(None, resume, progress=not quiet, resume=True))
-            return
-        extra = (f"train.seed={seed}",) if seed is not None else ()
-        print_summary(train_in_engine(load_experiment(config, overrides + extra), out, progress=not quiet))
-        return
     if resume is not None:
-        summary = train_run(None, resume, resume=True, progress=not quiet)
+        summary = train_run(None, resume, resume=True, progress=not quiet, engine=engine)
     else:
         extra = (f"train.seed={seed}",) if seed is not None else ()
         cfg = load_experiment(config, overrides + extra)
-        summary = train_run(cfg, out, progress=not quiet)
+        summary = train_run(cfg, out, progress=not quiet, engine=engine)
     print_summary(summary)
 
 

@@ -9,8 +9,9 @@ Per SMDP step (T engine turns):
 B battles run side by side and share out the configured number of rounds; rounds are numbered in the
 order they end (deterministic for a seed). :class:`Loop` holds everything that changes (arena arrays,
 learner, opponent, RNG states, metrics so far) as data, so a checkpointed run resumes exactly. Also here: the
-learner and model files of a config, the TD team (:func:`td_team`, a cached artefact) and
-:func:`record_round` (one greedy round as a replay). Run folders and the entry point are ``train.py``.
+learner and model files of a config, the TD team (:func:`td_team`, a cached artefact),
+:func:`record_round` (one greedy round as a replay) and :class:`SMDPTrainer`, the Loop as a trainer of the one
+training loop (``train.py``, which also makes the run folders).
 """
 
 from __future__ import annotations
@@ -37,10 +38,11 @@ from confront.experiments.spec import ExperimentConfig
 from confront.learning.base import Learner, Transition
 from confront.learning.factory import load_learner, make_learner, save_learner
 from confront.learning.tabular import TabularQ
-from confront.learning.transfer import TransferPolicy
+from confront.learning.transfer import TransferParams, TransferPolicy
+from confront.runs import Run
 
 __all__ = ["scenario_of", "smdp_config", "build_learner", "td_learner", "save_model", "load_model", "Side", "Loop",
-           "td_team", "run_rounds", "record_round"]
+           "SMDPTrainer", "td_team", "run_rounds", "record_round"]
 
 
 # -- building blocks ---------------------------------------------------------------------------------------------
@@ -238,6 +240,88 @@ class Loop:
         out = learner.learn(batch)
         if learner is self.side.learner:
             self.last_learn = out
+
+
+class SMDPTrainer:
+    """The paper's learners in the simulator as a trainer of ``train.train_run``: one SMDP step of every battle
+    per ``advance`` (the learner vs scripted robots or the TD team, curriculum transfer as configured)."""
+
+    engine = "sim"
+    bar_scalars = {"temperature": "T"}
+    final_window = 100
+
+    def __init__(self, cfg: ExperimentConfig, progress: bool = False) -> None:
+        self.cfg = cfg
+        scenario = scenario_of(cfg.arena.scenario)
+        env = TeamBattleEnv(scenario, n_battles=cfg.arena.battles, seed=cfg.train.seed, opponents=cfg.opponent.kind,
+                            config=smdp_config(cfg))
+        team = env.team_ids()
+        learner = build_learner(cfg, env.n_features, env.n_actions)
+        self.info: dict[str, Any] = {"scenario": scenario.name, "n_actions": env.n_actions,
+                                     "n_features": env.n_features}
+        side = Side(learner, ours=team == 0)
+        if cfg.opponent.kind == "td":
+            td, where = td_team(cfg, env.n_actions, progress=progress)
+            side.opponent, side.theirs, side.opponent_learns = td, team != 0, cfg.opponent.learning
+            self.info["td_model"] = str(where)
+        if cfg.transfer.source:
+            source, _ = load_model(cfg.transfer.source)
+            if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
+                raise ck.CheckpointError(
+                    f"transfer.source {cfg.transfer.source} has {source.n_actions} actions on {source.observation} "
+                    f"observations; this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
+            if cfg.transfer.init_from_source:
+                learner.load_state_dict(source.state_dict())
+            tc = cfg.transfer
+            side.learner = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
+            self.info["transfer_source"] = cfg.transfer.source
+        self.loop = Loop(env, side, seed=cfg.train.seed)
+        self.desc = f"{cfg.name} {scenario.name}"
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        return self.loop.rows
+
+    @property
+    def rounds_done(self) -> int:
+        return self.loop.rounds_done
+
+    @property
+    def decisions(self) -> int:
+        return self.loop.decisions
+
+    def advance(self, limit: int, tick: Any = None) -> dict[str, float]:
+        """One SMDP step; rounds past ``limit`` are dropped (battles share out the rounds)."""
+        loop = self.loop
+        ended = loop.step()
+        if not ended:
+            return {}
+        loop.rows.extend(ended)
+        if len(loop.rows) > limit:
+            del loop.rows[limit:]
+            loop.rounds_done = limit
+        return {k: v for k, v in loop.side.learner.diagnostics().items() if isinstance(v, int | float)}
+
+    def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        return self.loop.state()
+
+    def load(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None:
+        self.loop.load(arrays, meta)
+
+    def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
+        from confront.experiments.plots import session_plots
+
+        cfg, side = self.cfg, self.loop.side
+        save_model(run.path / "model", side.learner,
+                   {"scenario": self.info["scenario"], "decision_turns": cfg.arena.decision_turns,
+                    "fire_power_actions": cfg.arena.fire_power_actions, "target": cfg.arena.target})
+        figures = session_plots(run.plots, sessions, cfg.name, cfg.train.session_rounds)
+        replay = record_round(cfg, side, run.replays) if cfg.train.replay else None
+        return {"scenario": self.info["scenario"], "learner": side.learner.diagnostics(),
+                "figures": [str(f) for f in figures], "replay": replay, **self.info}
+
+    def close(self) -> None:
+        pass
 
 
 def td_team(cfg: ExperimentConfig, n_actions: int, progress: bool = False) -> tuple[Learner, Path]:

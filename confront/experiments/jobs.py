@@ -80,27 +80,17 @@ def _run_job(job: Job, rounds: int | None, engine: str = "sim") -> str:
 
     if (job.folder / "summary.json").exists():
         return "cached"
-    if engine == "robocode":  # live in the real engine (no checkpoints there: an unfinished run restarts)
-        import shutil
-
-        from confront.experiments.train_engine import train_in_engine
-
-        shutil.rmtree(job.folder, ignore_errors=True)
-        extra = [f"train.seed={job.seed}"]
-        if rounds is not None:
-            extra += [f"train.rounds={rounds}", f"train.session_rounds={max(1, min(10, rounds // 2))}"]
-        train_in_engine(load_experiment(job.base, job.overrides + tuple(extra)), job.folder, progress=False)
-        return "trained"
-    if (job.folder / "checkpoints" / "LATEST").exists():
-        train_run(None, job.folder, resume=True, progress=False)
+    if (job.folder / "checkpoints" / "LATEST").exists():  # a killed run continues (the engine's per battle)
+        train_run(None, job.folder, resume=True, progress=False, engine=engine)
         return "resumed"
     extra = [f"train.seed={job.seed}", "train.replay=false"]
     if rounds is not None:
         extra.append(f"train.rounds={rounds}")
         extra.append(f"train.session_rounds={max(1, min(10, rounds // 2))}")
-        extra.append(f"train.checkpoint_every={max(1, rounds // 2)}")
+        if engine == "sim":  # the engine checkpoints after each battle (train.checkpoint_every rounds long)
+            extra.append(f"train.checkpoint_every={max(1, rounds // 2)}")
     cfg = load_experiment(job.base, job.overrides + tuple(extra))
-    train_run(cfg, job.folder, progress=False, exist_ok=True)
+    train_run(cfg, job.folder, progress=False, exist_ok=True, engine=engine)
     return "trained"
 
 

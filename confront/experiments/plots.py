@@ -51,3 +51,22 @@ def plot_curves(curves: Mapping[str, np.ndarray], path: str | Path, *, ylabel: s
     fig.savefig(out)
     plt.close(fig)
     return out
+
+
+def session_plots(folder: Path, sessions: list[dict], name: str, session_rounds: int) -> list[Path]:
+    """A run's figures per session: score ratio, both sides' scores and (when the rows have it) defensive score."""
+    if not sessions:
+        return []
+
+    def col(key: str) -> np.ndarray:
+        return np.array([s[key] for s in sessions], dtype=np.float64)
+
+    figs = [plot_curves({name: col("score_ratio")}, folder / "score_ratio.png", ylabel="score ratio",
+                        title=f"{name}: score ratio per session of {session_rounds} rounds", hline=0.5),
+            plot_curves({"ours": col("score_ours"), "theirs": col("score_theirs")}, folder / "scores.png",
+                        ylabel="score per session", title=f"{name}: scores")]
+    if "defensive_ours" in sessions[0]:
+        figs.append(plot_curves({"ours": col("defensive_ours"), "theirs": col("defensive_theirs")},
+                                folder / "defensive.png", ylabel="defensive score per session",
+                                title=f"{name}: defensive score (survival + last-survivor bonus)"))
+    return figs

@@ -38,7 +38,7 @@ from confront.experiments.spec import ExperimentConfig
 from confront.learning.ppo import PPO, UPDATE_STATS, PPOConfig, Rollout
 from confront.runs import Run
 
-__all__ = ["train_tanks", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
+__all__ = ["TankTrainer", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
            "SnapshotPolicy",
            "save_tank_model", "load_tank_model", "evaluate_tanks"]
 
@@ -226,7 +226,12 @@ def load_tank_model(folder: str | Path, cfg: ExperimentConfig) -> PPO:
 # -- the loop ----------------------------------------------------------------------------------------------------
 
 class TankTrainer:
-    """Rollouts over the pool and PPO updates; all state is data (checkpoints resume exactly)."""
+    """Rollouts over the pool and PPO updates, one of each per ``advance`` (a trainer of ``train.train_run``);
+    all state is data (checkpoints resume exactly)."""
+
+    engine = "sim"
+    bar_scalars = {"decisions_per_s": "dps"}
+    final_window = 200
 
     def __init__(self, cfg: ExperimentConfig, progress: bool = False) -> None:
         self.cfg = cfg
@@ -239,6 +244,7 @@ class TankTrainer:
         self.decisions = 0
         self.elapsed = 0.0
         self.pending: Rollout | None = None  # the last rollout, which the next update() learns from
+        self.desc = f"{cfg.name} ppo"
         self._take_snapshot()
 
     @property
@@ -255,6 +261,10 @@ class TankTrainer:
     def _critic(self, obs: np.ndarray) -> np.ndarray:
         alive = obs[:, FEATURE_NAMES.index("energy")] > 0  # a dead tank has no energy
         return self.ppo.critic_input(obs, self.pool.group, self.pool.n_groups, alive)
+
+    def advance(self, limit: int, tick: Any = None) -> dict[str, Any]:
+        """One rollout and update (:meth:`update`); rounds past ``limit`` are kept (every battle ends its round)."""
+        return self.update()
 
     def update(self) -> dict[str, Any]:
         """One rollout of S steps, and one PPO update on the rollout before it (``ppo.overlap``: the two side by
@@ -310,6 +320,31 @@ class TankTrainer:
         buf.last_value = self.ppo.values(crit)
         return buf, t_env
 
+    def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
+        """The model, ``metrics/updates.csv``, the figures; the summary's PPO keys."""
+        from confront.experiments.plots import plot_curves, session_plots
+
+        cfg = self.cfg
+        run.write_table("updates", self.updates)
+        save_tank_model(run.path / "model", self.ppo, cfg, {"trained_rounds": len(rows)})
+        figs = session_plots(run.plots, sessions, cfg.name, cfg.train.session_rounds)
+        per: dict[str, list[float]] = {}
+        window = max(10, cfg.train.session_rounds // 4)
+        for name in sorted({r["opponent"] for r in rows}):
+            sub = [r for r in rows if r["opponent"] == name]
+            per[name] = [share_by_opponent(sub[i:i + window])[name] for i in range(0, len(sub) - window + 1, window)]
+        n = min((len(v) for v in per.values()), default=0)
+        if n > 1:
+            figs.append(plot_curves({k: np.array(v[:n]) for k, v in per.items()}, run.plots / "share_by_opponent.png",
+                                    ylabel="score share", hline=0.5,
+                                    title=f"{cfg.name}: share per opponent ({window}-round windows)"))
+        return {"learner": "ppo", "scenario": "league", "updates": self.ppo.updates,
+                "share_by_opponent_last": share_by_opponent(rows[-min(self.final_window, len(rows)):]),
+                "decisions_per_s": self.decisions / max(self.elapsed, 1e-9), "figures": [str(f) for f in figs]}
+
+    def close(self) -> None:
+        self.ppo.close()
+
     # checkpoint state
     def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         arrays = {f"pool.{k}": v for k, v in self.pool.state_dict().items()}
@@ -320,7 +355,7 @@ class TankTrainer:
         if self.pending is not None:
             arrays.update({f"pending.{k}": v for k, v in asdict(self.pending).items()})
         meta = {"kind": "ppo", "rounds_done": self.rounds_done, "decisions": self.decisions, "rows": self.rows,
-                "updates": self.updates, "elapsed_s": self.elapsed, "snapshots": len(self.snapshots),
+                "updates": self.updates, "update_elapsed_s": self.elapsed, "snapshots": len(self.snapshots),
                 "pool_rng": ck.rng_state(self.pool.rng)}
         return arrays, meta
 
@@ -338,7 +373,8 @@ class TankTrainer:
             pending = sub("pending.")
             self.pending = Rollout(**pending) if pending else None
             self.rows, self.updates = list(meta["rows"]), list(meta["updates"])
-            self.decisions, self.elapsed = int(meta["decisions"]), float(meta["elapsed_s"])
+            self.decisions = int(meta["decisions"])
+            self.elapsed = float(meta.get("update_elapsed_s", meta.get("elapsed_s", 0.0)))
             self.pool.rng = ck.rng_from_state(meta["pool_rng"])
         except (KeyError, ValueError, TypeError) as exc:
             raise ck.CheckpointError(f"checkpoint does not fit this run's config: {exc}") from None
@@ -363,107 +399,6 @@ def share_windows(rows: list[dict[str, Any]], size: int) -> list[tuple[int, floa
         t = sum(float(r["score_theirs"]) for r in chunk)
         out.append((end, o / (o + t) if o + t > 0 else 0.5))
     return out
-
-
-def tank_sessions(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
-    """Sessions of ``size`` rounds (in the order rounds ended): pooled score ratio, win rate, wall time."""
-    out = []
-    for start in range(0, len(rows) - size + 1, size):
-        chunk = rows[start:start + size]
-        o = sum(r["score_ours"] for r in chunk)
-        t = sum(r["score_theirs"] for r in chunk)
-        out.append({"session": len(out) + 1, "rounds": len(chunk), "score_ours": o, "score_theirs": t,
-                    "score_ratio": o / (o + t) if o + t > 0 else 0.5,
-                    "win_rate": sum(r["won"] for r in chunk) / len(chunk),
-                    "decisions": chunk[-1]["decisions"], "wall_s": chunk[-1].get("wall_s", 0.0)})
-    return out
-
-
-def train_tanks(cfg: ExperimentConfig, run: Run, resume: bool = False, progress: bool = True,
-                trainer: TankTrainer | None = None) -> dict[str, Any]:
-    """Train PPO tanks into ``run`` (or continue it); write metrics, model, plots; return the summary."""
-    from torch.utils.tensorboard import SummaryWriter
-    from tqdm import tqdm
-
-    trainer = trainer or TankTrainer(cfg, progress=progress)
-    if resume:
-        latest = ck.latest(run.checkpoints)
-        if latest is not None:
-            arrays, meta = ck.load(latest)
-            trainer.load(arrays, meta)
-            if progress:
-                click.echo(f"resuming {run.path} from {latest.name} ({trainer.rounds_done} rounds done)")
-    tc = cfg.train
-    writer = SummaryWriter(str(run.path / "tb"))
-    bar = tqdm(total=tc.rounds, initial=min(trainer.rounds_done, tc.rounds), desc=f"{cfg.name} ppo", unit="round",
-               disable=not progress, dynamic_ncols=True)
-    next_ckpt = (trainer.rounds_done // tc.checkpoint_every + 1) * tc.checkpoint_every
-    try:
-        while trainer.rounds_done < tc.rounds:
-            row = trainer.update()
-            step = row["decisions"]
-            recent = trainer.rows[-200:]
-            for name, v in share_by_opponent(recent).items():
-                writer.add_scalar(f"share/{name}", v, step)
-            for k in ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance",
-                      "decisions_per_s"):
-                writer.add_scalar(f"train/{k}", row[k], step)
-            o = sum(r["score_ours"] for r in recent)
-            t = sum(r["score_theirs"] for r in recent)
-            bar.update(min(trainer.rounds_done, tc.rounds) - bar.n)
-            bar.set_postfix(share=f"{o / (o + t) if o + t else 0.5:.3f}", dps=f"{row['decisions_per_s']:,.0f}",
-                            refresh=False)
-            if trainer.rounds_done >= next_ckpt and trainer.rounds_done < tc.rounds:
-                arrays, meta = trainer.state()
-                ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
-                next_ckpt = (trainer.rounds_done // tc.checkpoint_every + 1) * tc.checkpoint_every
-    finally:
-        bar.close()
-        writer.close()
-    rows = trainer.rows
-    sessions = tank_sessions(rows, tc.session_rounds)
-    run.write_table("rounds", rows)
-    run.write_table("sessions", sessions)
-    run.write_table("updates", trainer.updates)
-    save_tank_model(run.path / "model", trainer.ppo, cfg, {"trained_rounds": len(rows)})
-    figures = _plots(run, rows, sessions, cfg)
-    tail = rows[-min(200, len(rows)):]
-    o, t = sum(r["score_ours"] for r in tail), sum(r["score_theirs"] for r in tail)
-    summary = {
-        "name": cfg.name, "run": str(run.path), "learner": "ppo", "scenario": "league", "rounds": len(rows),
-        "sessions": len(sessions), "decisions": trainer.decisions, "updates": trainer.ppo.updates,
-        "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
-        "first_session_ratio": sessions[0]["score_ratio"] if sessions else math.nan,
-        "last_session_ratio": sessions[-1]["score_ratio"] if sessions else math.nan,
-        "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
-        "share_by_opponent_last": share_by_opponent(tail),
-        "decisions_per_s": trainer.decisions / max(trainer.elapsed, 1e-9), "wall_time_s": trainer.elapsed,
-        "figures": [str(f) for f in figures],
-    }
-    run.write_summary(summary)
-    return summary
-
-
-def _plots(run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]], cfg: ExperimentConfig
-           ) -> list[Path]:
-    from confront.experiments.plots import plot_curves
-
-    if not sessions:
-        return []
-    figs = [plot_curves({cfg.name: np.array([s["score_ratio"] for s in sessions])}, run.plots / "score_ratio.png",
-                        ylabel="score share", title=f"{cfg.name}: score share per session of "
-                        f"{cfg.train.session_rounds} rounds (all opponents)", hline=0.5)]
-    per: dict[str, list[float]] = {}
-    window = max(10, cfg.train.session_rounds // 4)
-    for name in sorted({r["opponent"] for r in rows}):
-        sub = [r for r in rows if r["opponent"] == name]
-        per[name] = [share_by_opponent(sub[i:i + window])[name] for i in range(0, len(sub) - window + 1, window)]
-    n = min((len(v) for v in per.values()), default=0)
-    if n > 1:
-        figs.append(plot_curves({k: np.array(v[:n]) for k, v in per.items()}, run.plots / "share_by_opponent.png",
-                                ylabel="score share", title=f"{cfg.name}: share per opponent ({window}-round windows)",
-                                hline=0.5))
-    return figs
 
 
 def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_000,

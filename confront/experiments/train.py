@@ -1,26 +1,38 @@
-"""Training one arm into a run folder: ``train_run`` for every learner (the paper's learners through
-:class:`~confront.experiments.episodes.Loop`, PPO tanks through :mod:`confront.experiments.tanks`).
+"""The one training loop: any learner over any battle backend, into a run folder.
 
-Checkpoints are taken every ``train.checkpoint_every`` rounds and hold everything that changes, so a run killed
-at any time and resumed with ``--resume`` ends with exactly the metrics of an uninterrupted run. The run folder
-holds ``config.toml``, ``metrics/`` (rounds, sessions), ``model/``, ``plots/``, ``replays/`` and ``summary.json``.
+    config -> Trainer (learner x backend) -> advance() until train.rounds -> rows -> sessions, model, plots
+
+A :class:`Trainer` plays and learns in steps and holds all it changes as data. Three implement it:
+:class:`~confront.experiments.episodes.SMDPTrainer` (the paper's learners in the simulator),
+:class:`~confront.experiments.tanks.TankTrainer` (PPO tanks in the simulator's league) and
+:class:`~confront.experiments.train_engine.EngineTrainer` (the paper's learners live in Robocode, one battle
+per step). :func:`train_run` is the loop around them, the same for all three: resume, progress bar,
+TensorBoard scalars (``tb/``), checkpoints every ``train.checkpoint_every`` rounds, then the run's tables,
+summary and figures.
+
+Checkpoints hold everything that changes, so a simulator run killed at any time and resumed with ``--resume``
+ends with exactly the metrics of an uninterrupted run (an engine run loses at most the battle that was running).
+The run folder holds ``config.toml``, ``metrics/`` (rounds, sessions), ``model/``, ``plots/``, ``tb/``,
+``checkpoints/`` and ``summary.json``.
 """
 
 from __future__ import annotations
 
+import math
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import click
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.arena.smdp import TeamBattleEnv
-from confront.config import load_toml, to_dict
+from confront.config import ConfigError, load_toml, to_dict
 from confront.experiments.episodes import (  # the building blocks, re-exported (train.py was their home)
     Loop,
     Side,
+    SMDPTrainer,
     build_learner,
     load_model,
     record_round,
@@ -32,19 +44,72 @@ from confront.experiments.episodes import (  # the building blocks, re-exported 
     td_team,
 )
 from confront.experiments.spec import ExperimentConfig, config_from_dict
-from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
-__all__ = ["train_run", "print_summary", "new_run", "resume_run", "session_rows",
-           "Loop", "Side", "build_learner", "load_model", "record_round", "run_rounds", "save_model", "scenario_of",
-           "smdp_config", "td_learner", "td_team"]
+__all__ = ["Trainer", "SMDPTrainer", "make_trainer", "train_run", "print_summary", "new_run", "resume_run",
+           "session_rows", "Loop", "Side", "build_learner", "load_model", "record_round", "run_rounds", "save_model",
+           "scenario_of", "smdp_config", "td_learner", "td_team"]
+
+ENGINES = ("sim", "robocode")
+
+
+class Trainer(Protocol):
+    """One learner on one battle backend, advanced step by step; its state is data (checkpoints)."""
+
+    engine: str  # the backend, "sim" or "robocode" (checkpoints say which)
+    desc: str  # progress-bar label
+    bar_scalars: dict[str, str]  # scalar name -> progress-bar label
+    final_window: int  # rounds the summary's final score ratio pools
+    rows: list[dict[str, Any]]  # one per round, in the order rounds ended
+    decisions: int
+
+    @property
+    def rounds_done(self) -> int: ...
+
+    def advance(self, limit: int, tick: Callable[[int], None]) -> dict[str, float]:
+        """Play (and learn) one step towards ``limit`` rounds; ``tick(rounds)`` reports rounds done within a long
+        step. Returns the step's scalars (TensorBoard)."""
+        ...
+
+    def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]: ...
+
+    def load(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None: ...
+
+    def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
+        """Write the model and the trainer's own tables and figures; return its summary keys."""
+        ...
+
+    def close(self) -> None: ...
+
+
+def make_trainer(cfg: ExperimentConfig, run: Run, engine: str = "sim", progress: bool = False,
+                 cpu_constant_ms: float | None = None) -> Trainer:
+    """The trainer of ``cfg``'s learner on ``engine`` (imports the backend it needs only)."""
+    if engine not in ENGINES:
+        raise ConfigError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if cfg.learner.kind == "ppo":
+        if engine != "sim":
+            raise ConfigError("PPO tanks train in the simulator (all league battles in one call); "
+                              "`confront export RUN` makes the trained policy a Robocode robot")
+        from confront.experiments.tanks import TankTrainer
+
+        return TankTrainer(cfg, progress=progress)
+    if engine == "robocode":
+        from confront.experiments.train_engine import EngineTrainer
+
+        return EngineTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
+    return SMDPTrainer(cfg, progress=progress)
 
 
 # -- run folders -------------------------------------------------------------------------------------------------
 
 def session_rows(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
-    """Aggregate round rows into sessions of ``size`` rounds (paper: 10); the score ratio pools the sums."""
+    """Aggregate round rows into sessions of ``size`` rounds (paper: 10); the score ratio pools the sums. Score
+    parts the rows carry are summed; ``decisions`` and ``wall_s`` are the session's last round's."""
     out: list[dict[str, Any]] = []
+    summed = [k for k in ("defensive_ours", "defensive_theirs", "bullet_damage_ours", "bullet_damage_theirs")
+              if rows and k in rows[0]]
+    last = [k for k in ("decisions", "wall_s") if rows and k in rows[0]]
     for start in range(0, len(rows) - size + 1, size):
         chunk = rows[start:start + size]
         o = sum(r["score_ours"] for r in chunk)
@@ -54,41 +119,10 @@ def session_rows(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
             "session": len(out) + 1, "rounds": len(chunk), "score_ours": o, "score_theirs": t,
             "score_ratio": ratio,
             "fluctuation": ratio - out[-1]["score_ratio"] if out else 0.0,  # Fig. 11: first difference
-            "defensive_ours": sum(r["defensive_ours"] for r in chunk),
-            "defensive_theirs": sum(r["defensive_theirs"] for r in chunk),
             "win_rate": sum(r["won"] for r in chunk) / len(chunk),
-            "bullet_damage_ours": sum(r["bullet_damage_ours"] for r in chunk),
-            "bullet_damage_theirs": sum(r["bullet_damage_theirs"] for r in chunk),
+            **{k: sum(r[k] for r in chunk) for k in summed}, **{k: chunk[-1][k] for k in last},
         })
     return out
-
-
-def _setup(cfg: ExperimentConfig, progress: bool) -> tuple[Loop, dict[str, Any]]:
-    scenario = scenario_of(cfg.arena.scenario)
-    smdp = smdp_config(cfg)
-    opponents = "td" if cfg.opponent.kind == "td" else cfg.opponent.kind
-    env = TeamBattleEnv(scenario, n_battles=cfg.arena.battles, seed=cfg.train.seed, opponents=opponents,
-                        config=smdp)
-    team = env.team_ids()
-    learner = build_learner(cfg, env.n_features, env.n_actions)
-    info: dict[str, Any] = {"scenario": scenario.name, "n_actions": env.n_actions, "n_features": env.n_features}
-    side = Side(learner, ours=team == 0)
-    if cfg.opponent.kind == "td":
-        td, where = td_team(cfg, env.n_actions, progress=progress)
-        side.opponent, side.theirs, side.opponent_learns = td, team != 0, cfg.opponent.learning
-        info["td_model"] = str(where)
-    if cfg.transfer.source:
-        source, _ = load_model(cfg.transfer.source)
-        if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
-            raise ck.CheckpointError(
-                f"transfer.source {cfg.transfer.source} has {source.n_actions} actions on {source.observation} "
-                f"observations; this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
-        if cfg.transfer.init_from_source:
-            learner.load_state_dict(source.state_dict())
-        tc = cfg.transfer
-        side.learner = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
-        info["transfer_source"] = cfg.transfer.source
-    return Loop(env, side, seed=cfg.train.seed), info
 
 
 def resume_run(out: str | Path | None) -> tuple[Run, ExperimentConfig]:
@@ -109,99 +143,110 @@ def new_run(cfg: ExperimentConfig, out: str | Path | None, exist_ok: bool = Fals
                       exist_ok=exist_ok)
 
 
+def _pooled(rows: list[dict[str, Any]]) -> float:
+    o = sum(r["score_ours"] for r in rows)
+    t = sum(r["score_theirs"] for r in rows)
+    return o / (o + t) if o + t > 0 else 0.5
+
+
+def _log(writer: Any, trainer: Trainer, scalars: dict[str, float], window: int) -> None:
+    """TensorBoard scalars at the trainer's decision count: score share (overall, per opponent) and the step's."""
+    step = trainer.decisions
+    recent = trainer.rows[-window:]
+    writer.add_scalar("share/all", _pooled(recent), step)
+    for name in sorted({r["opponent"] for r in recent if "opponent" in r}):
+        writer.add_scalar(f"share/{name}", _pooled([r for r in recent if r.get("opponent") == name]), step)
+    for k, v in scalars.items():
+        if isinstance(v, int | float) and math.isfinite(v):
+            writer.add_scalar(f"train/{k}", v, step)
+
+
 def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool = False, progress: bool = True,
-              exist_ok: bool = False) -> dict[str, Any]:
-    """Train one arm into a run folder (or continue it with ``resume``); return its summary."""
-    start = time.time()
+              exist_ok: bool = False, engine: str = "sim", cpu_constant_ms: float | None = None) -> dict[str, Any]:
+    """Train ``cfg``'s learner on ``engine`` ("sim" or "robocode") into a run folder, or continue the run in
+    ``out`` with ``resume`` (its own config); return the summary."""
+    t_setup = time.time()
     if resume:
         run, cfg = resume_run(out)
     elif cfg is None:
         raise ValueError("train_run needs a config unless resuming")
     else:
         run = new_run(cfg, out, exist_ok)
-    if cfg.learner.kind == "ppo":  # the recommended learner: its own rollout loop over the league (tanks.py)
-        from confront.experiments.tanks import TankTrainer, train_tanks
-
-        try:
-            trainer = TankTrainer(cfg, progress=progress)
-        except Exception:
-            run.discard_if_new()  # a failed start leaves no half-made run folder
-            raise
-        return train_tanks(cfg, run, resume=resume, progress=progress, trainer=trainer)
     try:
-        loop, info = _setup(cfg, progress)
+        trainer = make_trainer(cfg, run, engine, progress=progress, cpu_constant_ms=cpu_constant_ms)
     except Exception:
         run.discard_if_new()  # a failed start leaves no half-made run folder
         raise
+    try:
+        return _train(cfg, run, trainer, resume, progress, setup_s=time.time() - t_setup)
+    finally:
+        trainer.close()
+
+
+def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, progress: bool,
+           setup_s: float) -> dict[str, Any]:
+    from torch.utils.tensorboard import SummaryWriter
+    from tqdm import tqdm
+
     elapsed_before = 0.0
-    if resume:
-        latest = ck.latest(run.checkpoints)
-        if latest is not None:
-            arrays, meta = ck.load(latest)
-            if meta.get("engine") == "robocode":
-                raise ck.CheckpointError(f"{latest} was trained in the real engine: resume it with --engine robocode")
-            loop.load(arrays, meta)
-            elapsed_before = float(meta.get("elapsed_s", 0.0))
-            if progress:
-                click.echo(f"resuming {run.path} from {latest.name} ({loop.rounds_done} rounds done)")
+    if resume and (latest := ck.latest(run.checkpoints)) is not None:
+        arrays, meta = ck.load(latest)
+        if meta.get("engine", "sim") != trainer.engine:
+            raise ck.CheckpointError(f"{latest} was trained with --engine {meta.get('engine', 'sim')}: resume it "
+                                     f"with that engine")
+        trainer.load(arrays, meta)
+        elapsed_before = float(meta.get("elapsed_s", 0.0))
+        if progress:
+            click.echo(f"resuming {run.path} from {latest.name} ({trainer.rounds_done} rounds done)")
     tc = cfg.train
-    next_ckpt = [(loop.rounds_done // tc.checkpoint_every + 1) * tc.checkpoint_every]
+    total, every, window = tc.rounds, tc.checkpoint_every, min(tc.session_rounds, 200)
+    start = time.time()
+    next_ckpt = (trainer.rounds_done // every + 1) * every
+    bar = tqdm(total=total, initial=min(trainer.rounds_done, total), desc=trainer.desc, unit="round",
+               disable=not progress, dynamic_ncols=True)
+    writer = SummaryWriter(str(run.path / "tb"))
 
-    def on_rounds(lp: Loop) -> None:
-        if lp.rounds_done >= next_ckpt[0] and lp.rounds_done < tc.rounds:
-            arrays, meta = lp.state()
-            meta["elapsed_s"] = elapsed_before + time.time() - start
-            ck.save(run.checkpoints, f"round-{lp.rounds_done:06d}", arrays, meta)
-            run.write_table("rounds", lp.rows)
-            next_ckpt[0] = (lp.rounds_done // tc.checkpoint_every + 1) * tc.checkpoint_every
+    def tick(rounds: int) -> None:
+        bar.update(min(rounds, total) - bar.n)
 
-    run_rounds(loop, tc.rounds, progress, desc=f"{cfg.name} {info['scenario']}", on_rounds=on_rounds,
-         session=tc.session_rounds)
-    rows = loop.rows[: tc.rounds]
+    try:
+        while trainer.rounds_done < total:
+            before = trainer.rounds_done
+            scalars = trainer.advance(total, tick)
+            if trainer.rounds_done == before:
+                continue
+            tick(trainer.rounds_done)
+            bar.set_postfix(share=f"{_pooled(trainer.rows[-window:]):.3f}", refresh=False,
+                            **{label: f"{scalars[k]:,.0f}" if abs(scalars[k]) >= 100 else f"{scalars[k]:.3f}"
+                               for k, label in trainer.bar_scalars.items() if k in scalars})
+            _log(writer, trainer, scalars, window)
+            if next_ckpt <= trainer.rounds_done < total:
+                arrays, meta = trainer.state()
+                meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start)
+                ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
+                run.write_table("rounds", trainer.rows)
+                next_ckpt = (trainer.rounds_done // every + 1) * every
+    finally:
+        bar.close()
+        writer.close()
+    rows = trainer.rows
     sessions = session_rows(rows, tc.session_rounds)
     run.write_table("rounds", rows)
     run.write_table("sessions", sessions)
-    save_model(run.path / "model", loop.side.learner,
-               {"scenario": info["scenario"], "decision_turns": cfg.arena.decision_turns,
-                "fire_power_actions": cfg.arena.fire_power_actions, "target": cfg.arena.target})
-    figures = _plots(run, rows, sessions, cfg)
-    replay = _replay(run, cfg, loop.side) if cfg.train.replay else None
-    tail = rows[-min(100, len(rows)):]
-    o, t = sum(r["score_ours"] for r in tail), sum(r["score_theirs"] for r in tail)
-    summary = {
-        "name": cfg.name, "run": str(run.path), "scenario": info["scenario"], "rounds": len(rows),
-        "sessions": len(sessions), "decisions": loop.decisions,
-        "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
+    tail = rows[-min(trainer.final_window, len(rows)):]
+    summary: dict[str, Any] = {
+        "name": cfg.name, "run": str(run.path), "engine": trainer.engine, "rounds": len(rows),
+        "sessions": len(sessions), "decisions": trainer.decisions,
+        "final_score_ratio": _pooled(tail), "final_window_rounds": len(tail),
+        "first_session_ratio": sessions[0]["score_ratio"] if sessions else math.nan,
+        "last_session_ratio": sessions[-1]["score_ratio"] if sessions else math.nan,
         "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
         "score_ours": sum(r["score_ours"] for r in rows), "score_theirs": sum(r["score_theirs"] for r in rows),
-        "learner": loop.side.learner.diagnostics(), "wall_time_s": elapsed_before + time.time() - start,
-        "figures": [str(f) for f in figures], "replay": replay, **info,
+        "wall_time_s": elapsed_before + time.time() - start, "setup_s": setup_s,
     }
+    summary.update(trainer.finish(run, rows, sessions))
     run.write_summary(summary)
     return summary
-
-
-def _plots(run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]], cfg: ExperimentConfig) -> list[Path]:
-    from confront.experiments.plots import plot_curves
-
-    if not sessions:
-        return []
-    ratio = np.array([s["score_ratio"] for s in sessions])
-    figs = [plot_curves({cfg.name: ratio}, run.plots / "score_ratio.png", ylabel="score ratio",
-                        title=f"{cfg.name}: score ratio per session of {cfg.train.session_rounds} rounds", hline=0.5),
-            plot_curves({"ours": np.array([s["score_ours"] for s in sessions]),
-                         "theirs": np.array([s["score_theirs"] for s in sessions])},
-                        run.plots / "scores.png", ylabel="score per session", title=f"{cfg.name}: scores"),
-            plot_curves({"ours": np.array([s["defensive_ours"] for s in sessions]),
-                         "theirs": np.array([s["defensive_theirs"] for s in sessions])},
-                        run.plots / "defensive.png", ylabel="defensive score per session",
-                        title=f"{cfg.name}: defensive score (survival + last-survivor bonus)")]
-    return figs
-
-
-def _replay(run: Run, cfg: ExperimentConfig, side: Side) -> str | None:
-    """Record one greedy round of the trained team in a fresh battle: replay JSON, GIF and HTML."""
-    return record_round(cfg, side, run.replays)
 
 
 def print_summary(summary: dict[str, Any]) -> None:
@@ -212,7 +257,8 @@ def print_summary(summary: dict[str, Any]) -> None:
         return print_tank_summary(summary)
     run = Run(Path(summary["run"]))
     sessions = run.read_table("sessions")
-    click.echo(f"\n{summary['name']}: {summary['rounds']} rounds of {summary['scenario']} in "
+    where = " in Robocode" if summary.get("engine") == "robocode" else ""
+    click.echo(f"\n{summary['name']}: {summary['rounds']} rounds of {summary['scenario']}{where} in "
                f"{summary['wall_time_s']:.1f} s ({summary['decisions']} decisions)")
     if sessions:
         click.echo("\n| session | score ours | score theirs | score ratio | defensive ours | win rate |")
@@ -220,7 +266,7 @@ def print_summary(summary: dict[str, Any]) -> None:
         step = max(1, len(sessions) // 10)
         for s in sessions[::step] + ([sessions[-1]] if (len(sessions) - 1) % step else []):
             click.echo(f"| {s['session']} | {s['score_ours']:.0f} | {s['score_theirs']:.0f} | "
-                       f"{s['score_ratio']:.3f} | {s['defensive_ours']:.0f} | {s['win_rate']:.2f} |")
+                       f"{s['score_ratio']:.3f} | {s.get('defensive_ours', math.nan):.0f} | {s['win_rate']:.2f} |")
     click.echo(f"\nscore ratio over the last {summary['final_window_rounds']} rounds: "
                f"{summary['final_score_ratio']:.3f} (win rate {summary['win_rate_last']:.2f})")
-    click.echo(f"run folder: {summary['run']}  (plots/, metrics/, model/, summary.json)")
+    click.echo(f"run folder: {summary['run']}  (plots/, metrics/, model/, tb/, summary.json)")

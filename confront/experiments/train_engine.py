@@ -1,4 +1,5 @@
-"""Training a config's learner live in the real engine (``confront train --engine robocode``).
+"""Training a config's learner live in the real engine (``confront train --engine robocode``): the
+:class:`EngineTrainer` of the one training loop (``train.train_run``), one battle per step.
 
 Our side is a team of BridgeBots sharing one learner through the bridge (parameter sharing; ``LearnerPolicy``:
 a round trip only every ``arena.decision_turns`` turns, the gun/radar controller in Java, the Eq. 35 rewards from
@@ -20,7 +21,6 @@ an uninterrupted one (the simulator's runs are); it loses at most the battle tha
 from __future__ import annotations
 
 import tempfile
-import time
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -41,22 +41,13 @@ from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.install import find_engine
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
+from confront.experiments.episodes import build_learner, load_model, save_model, td_team
 from confront.experiments.spec import ExperimentConfig
-from confront.experiments.train import (
-    _plots,
-    build_learner,
-    load_model,
-    new_run,
-    resume_run,
-    save_model,
-    session_rows,
-    td_team,
-)
 from confront.learning.base import Learner
 from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
-__all__ = ["train_in_engine", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
+__all__ = ["EngineTrainer", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
 
 # simulator score part -> the engine's score snapshot key [Robocode RobotStatistics; ram_dmg already x2]
 ENGINE_PARTS: dict[str, str] = {
@@ -156,14 +147,15 @@ def _transfer(cfg: ExperimentConfig, learner: Learner) -> tuple[Learner, dict[st
 
 
 class _Progress:
-    """Bridge policy wrapper that advances a progress bar as rounds end (``done`` rounds before this battle)."""
+    """Bridge policy wrapper that reports rounds as they start (``done`` rounds before this battle) to ``tick``."""
 
-    def __init__(self, policy: LearnerPolicy, bar: Any, done: int) -> None:
-        self.policy, self.bar, self.done = policy, bar, done
+    def __init__(self, policy: LearnerPolicy, tick: Any, done: int) -> None:
+        self.policy, self.tick, self.done, self.seen = policy, tick, done, 0
 
     def __call__(self, obs: Observation) -> Action:
-        if self.done + obs.round > self.bar.n:
-            self.bar.update(self.done + obs.round - self.bar.n)
+        if self.tick is not None and obs.round > self.seen:
+            self.seen = obs.round
+            self.tick(self.done + obs.round)
         return self.policy(obs)
 
     def end_episode(self, robot: str, round_: int, history: Sequence[TurnEnergy] = ()) -> None:
@@ -175,136 +167,116 @@ def _battle(cfg: ExperimentConfig, opponent: str, rounds: int) -> BattleSpec:
     return _single_star(_single_star(spec, BRIDGE_BOT), POLICY_BOT)
 
 
-def _checkpoint(run: Run, learner: Learner, policy: LearnerPolicy, state: dict[str, Any]) -> None:
-    arrays = {f"learner.{k}": v for k, v in learner.state_dict().items()}
-    meta = {**state, "engine": "robocode", "rng": ck.rng_state(policy.rng), "decisions": policy.decisions,
-            "updates": policy.updates}
-    ck.save(run.checkpoints, f"round-{state['rounds_done']:06d}", arrays, meta)
+class EngineTrainer:
+    """The paper's learners live in Robocode: each ``advance`` plays one battle of ``train.checkpoint_every``
+    rounds (engine seed ``train.seed + battle``) with the learner deciding for our BridgeBots."""
 
+    engine = "robocode"
+    bar_scalars: dict[str, str] = {}
+    final_window = 100
 
-def _restore(run: Run, learner: Learner, policy: LearnerPolicy) -> dict[str, Any]:
-    latest = ck.latest(run.checkpoints)
-    if latest is None:
-        return {}
-    arrays, meta = ck.load(latest)
-    if meta.get("engine") != "robocode":
-        raise CheckpointError(f"{latest} is a simulator checkpoint: resume it without --engine robocode")
-    try:
-        learner.load_state_dict({k[len("learner."):]: v for k, v in arrays.items() if k.startswith("learner.")})
-        policy.rng = ck.rng_from_state(meta["rng"])
-        policy.decisions, policy.updates = int(meta["decisions"]), int(meta["updates"])
-        return {k: meta[k] for k in ("rounds_done", "battles", "rows", "skipped_turns", "bridge_failures",
-                                     "bridge_errors", "rtt_sum_us", "rtt_battles", "setup_s", "elapsed_s")}
-    except (KeyError, ValueError, TypeError) as exc:
-        raise CheckpointError(f"checkpoint {latest} does not fit this run's config: {exc}") from None
+    def __init__(self, cfg: ExperimentConfig, run: Run, progress: bool = False,
+                 cpu_constant_ms: float | None = None) -> None:
+        _check(cfg)
+        find_engine()  # no engine: a one-line error
+        self.cfg, self.run = cfg, run
+        self.cpu_constant_ms = BRIDGE_CPU_CONSTANT_MS if cpu_constant_ms is None else cpu_constant_ms
+        self.obs_cfg = ObservationConfig(target=cfg.arena.target)
+        self.learner = build_learner(cfg, self.obs_cfg.n_features, N_MOVES)
+        self.acting, self.info = _transfer(cfg, self.learner)
+        self.policy = LearnerPolicy(self.acting, np.random.default_rng([cfg.train.seed, 0]), train=True,
+                                    explore=True, observation=self.obs_cfg, step_turns=cfg.arena.decision_turns)
+        self.rows: list[dict[str, Any]] = []
+        self.battles, self.skipped_turns, self.rtt_sum_us, self.rtt_battles, self.engine_setup_s = 0, 0, 0.0, 0, 0.0
+        self.failures: list[str] = []
+        self.errors: list[str] = []
+        self._tmp = tempfile.TemporaryDirectory(prefix="confront-train-")
+        try:
+            self.opponent, self.extra, opp_info = _opponent(cfg, self.obs_cfg, Path(self._tmp.name) / "robots",
+                                                            progress)
+        except Exception:
+            self._tmp.cleanup()
+            raise
+        self.info.update(opp_info)
+        self.desc = f"{cfg.name} {cfg.arena.scenario} (robocode)"
 
+    @property
+    def rounds_done(self) -> int:
+        return len(self.rows)
 
-def train_in_engine(
-    cfg: ExperimentConfig | None,
-    out: str | Path | None,
-    progress: bool = True,
-    cpu_constant_ms: float = BRIDGE_CPU_CONSTANT_MS,
-    exist_ok: bool = False,
-    resume: bool = False,
-) -> dict[str, Any]:
-    """Train ``cfg``'s learner for ``train.rounds`` rounds in the real engine into the run folder ``out``
-    (default ``runs/<name>-<time>``, as the simulator's ``train_run``); ``resume`` continues the run in ``out``
-    from its latest checkpoint (``cfg`` is then read from the run folder).
+    @property
+    def decisions(self) -> int:
+        return self.policy.decisions
 
-    Returns the summary (train_run's keys plus ``engine``, ``battles``, ``skipped_turns``, ``bridge_failures``,
-    ``bridge_errors``, ``updates``, ``rtt_mean_us``, ``cpu_constant_ms``). Bad config values raise ValueError.
-    """
-    start = time.time()
-    if resume:
-        run, cfg = resume_run(out)
-    elif cfg is None:
-        raise ValueError("train_in_engine needs a config unless resuming")
-    _check(cfg)
-    find_engine()  # no engine: a one-line error before any run folder is made
-    obs_cfg = ObservationConfig(target=cfg.arena.target)
-    learner = build_learner(cfg, obs_cfg.n_features, N_MOVES)
-    acting, transfer_info = _transfer(cfg, learner)
-    if not resume:
-        run = new_run(cfg, out, exist_ok)
-    policy = LearnerPolicy(acting, np.random.default_rng([cfg.train.seed, 0]), train=True, explore=True,
-                           observation=obs_cfg, step_turns=cfg.arena.decision_turns)
-    state: dict[str, Any] = {"rounds_done": 0, "battles": 0, "rows": [], "skipped_turns": 0, "bridge_failures": [],
-                             "bridge_errors": [], "rtt_sum_us": 0.0, "rtt_battles": 0, "setup_s": 0.0,
-                             "elapsed_s": 0.0}
-    if resume:
-        state.update(_restore(run, acting, policy))
-    elapsed_before = float(state["elapsed_s"])
-    total, chunk = cfg.train.rounds, cfg.train.checkpoint_every
-    (run.path / "engine").mkdir(exist_ok=True)
-    from tqdm import tqdm
+    def advance(self, limit: int, tick: Any = None) -> dict[str, float]:
+        """One battle of up to ``train.checkpoint_every`` rounds; its engine results go to engine/battle-NNN/."""
+        done = self.rounds_done
+        rounds = min(self.cfg.train.checkpoint_every, limit - done)
+        # a training battle gets time: 10 s per round on top of the default limit
+        opts = EngineOptions(seed=self.cfg.train.seed + self.battles, cpu_constant_ms=self.cpu_constant_ms)
+        opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * rounds)
+        res: BridgedRun = run_bridged_battle(_battle(self.cfg, self.opponent, rounds),
+                                             _Progress(self.policy, tick, done), opts, extra_robots=self.extra,
+                                             **self.policy.bridge_kwargs())
+        self.policy.end_all()  # rounds restart at 0 in the next battle
+        rows = round_rows(res.run.summary["round_scores"])
+        for r in rows:
+            r["battle"], r["round"] = self.battles, r["round"] + done
+        folder = self.run.path / "engine" / f"battle-{self.battles:03d}"
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "results.txt").write_text(res.run.results_text)  # the engine's own results file
+        (folder / "results.csv").write_text(res.run.results.to_csv())
+        self.rows += rows
+        self.battles += 1
+        self.skipped_turns += sum(res.run.skipped_turns.values())
+        self.failures += list(res.failures)
+        self.errors += list(res.server_errors)
+        if not np.isnan(res.rtt_mean_us):
+            self.rtt_sum_us += res.rtt_mean_us
+            self.rtt_battles += 1
+        self.engine_setup_s += res.run.setup_s
+        return {"skipped_turns": float(self.skipped_turns), "updates": float(self.policy.updates),
+                **({"rtt_mean_us": res.rtt_mean_us} if not np.isnan(res.rtt_mean_us) else {})}
 
-    bar = tqdm(total=total, initial=state["rounds_done"], desc=f"{cfg.name} {cfg.arena.scenario} (robocode)",
-               unit="round", disable=not progress, dynamic_ncols=True)
-    try:
-        with tempfile.TemporaryDirectory(prefix="confront-train-") as tmp:
-            try:
-                opponent, extra, info = _opponent(cfg, obs_cfg, Path(tmp) / "robots", progress)
-            except Exception:
-                if not resume:
-                    run.discard_if_new()  # a failed start leaves no half-made run folder
-                raise
-            while state["rounds_done"] < total:
-                rounds = min(chunk, total - state["rounds_done"])
-                # a training battle gets time: 10 s per round on top of the default limit
-                opts = EngineOptions(seed=cfg.train.seed + state["battles"], cpu_constant_ms=cpu_constant_ms)
-                opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * rounds)
-                res: BridgedRun = run_bridged_battle(_battle(cfg, opponent, rounds),
-                                                     _Progress(policy, bar, state["rounds_done"]), opts,
-                                                     extra_robots=extra, **policy.bridge_kwargs())
-                policy.end_all()  # rounds restart at 0 in the next battle
-                rows = round_rows(res.run.summary["round_scores"])
-                for r in rows:
-                    r["battle"], r["round"] = state["battles"], r["round"] + state["rounds_done"]
-                folder = run.path / "engine" / f"battle-{state['battles']:03d}"
-                folder.mkdir(exist_ok=True)
-                (folder / "results.txt").write_text(res.run.results_text)  # the engine's own results file
-                (folder / "results.csv").write_text(res.run.results.to_csv())
-                state["rows"] += rows
-                state["rounds_done"] += rounds
-                state["battles"] += 1
-                state["skipped_turns"] += sum(res.run.skipped_turns.values())
-                state["bridge_failures"] += list(res.failures)
-                state["bridge_errors"] += list(res.server_errors)
-                if not np.isnan(res.rtt_mean_us):
-                    state["rtt_sum_us"] += res.rtt_mean_us
-                    state["rtt_battles"] += 1
-                state["setup_s"] += res.run.setup_s
-                state["elapsed_s"] = elapsed_before + time.time() - start
-                bar.update(state["rounds_done"] - bar.n)
-                run.write_table("rounds", state["rows"])
-                if state["rounds_done"] < total:
-                    _checkpoint(run, acting, policy, state)
-    finally:
-        bar.close()
-    rows = state["rows"]
-    sessions = session_rows(rows, cfg.train.session_rounds)
-    run.write_table("rounds", rows)
-    run.write_table("sessions", sessions)
-    save_model(run.path / "model", learner,
-               {"scenario": cfg.arena.scenario, "decision_turns": cfg.arena.decision_turns,
-                "fire_power_actions": False, "target": cfg.arena.target, "engine": "robocode"})
-    figures = _plots(run, rows, sessions, cfg)
-    tail = rows[-min(100, len(rows)):]
-    o, t = sum(r["score_ours"] for r in tail), sum(r["score_theirs"] for r in tail)
-    summary: dict[str, Any] = {
-        "name": cfg.name, "run": str(run.path), "scenario": cfg.arena.scenario, "rounds": len(rows),
-        "sessions": len(sessions), "decisions": policy.decisions,
-        "final_score_ratio": o / (o + t) if o + t else 0.5, "final_window_rounds": len(tail),
-        "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),
-        "score_ours": sum(r["score_ours"] for r in rows), "score_theirs": sum(r["score_theirs"] for r in rows),
-        "learner": acting.diagnostics(), "wall_time_s": elapsed_before + time.time() - start,
-        "figures": [str(f) for f in figures], "replay": None,
-        "n_actions": N_MOVES, "n_features": obs_cfg.n_features, **info, **transfer_info,
-        "engine": "robocode", "battles": state["battles"], "cpu_constant_ms": cpu_constant_ms,
-        "updates": policy.updates, "skipped_turns": state["skipped_turns"],
-        "bridge_failures": state["bridge_failures"], "bridge_errors": state["bridge_errors"],
-        "rtt_mean_us": state["rtt_sum_us"] / state["rtt_battles"] if state["rtt_battles"] else None,
-        "engine_setup_s": state["setup_s"],
-    }
-    run.write_summary(summary)
-    return summary
+    def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        arrays = {f"learner.{k}": v for k, v in self.acting.state_dict().items()}
+        meta = {"rounds_done": self.rounds_done, "rows": self.rows, "battles": self.battles,
+                "skipped_turns": self.skipped_turns, "bridge_failures": self.failures, "bridge_errors": self.errors,
+                "rtt_sum_us": self.rtt_sum_us, "rtt_battles": self.rtt_battles, "setup_s": self.engine_setup_s,
+                "rng": ck.rng_state(self.policy.rng), "decisions": self.policy.decisions,
+                "updates": self.policy.updates}
+        return arrays, meta
+
+    def load(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None:
+        try:
+            self.acting.load_state_dict({k[len("learner."):]: v for k, v in arrays.items()
+                                         if k.startswith("learner.")})
+            self.policy.rng = ck.rng_from_state(meta["rng"])
+            self.policy.decisions, self.policy.updates = int(meta["decisions"]), int(meta["updates"])
+            self.rows, self.battles = list(meta["rows"]), int(meta["battles"])
+            self.skipped_turns, self.rtt_battles = int(meta["skipped_turns"]), int(meta["rtt_battles"])
+            self.failures, self.errors = list(meta["bridge_failures"]), list(meta["bridge_errors"])
+            self.rtt_sum_us, self.engine_setup_s = float(meta["rtt_sum_us"]), float(meta["setup_s"])
+        except (KeyError, ValueError, TypeError) as exc:
+            raise CheckpointError(f"the checkpoint does not fit this run's config: {exc}") from None
+
+    def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
+        """The model and figures; the summary keys (train_run's plus the engine's skipped turns, bridge
+        failures and errors, round trips and the engine's own setup time)."""
+        from confront.experiments.plots import session_plots
+
+        cfg = self.cfg
+        save_model(run.path / "model", self.learner,
+                   {"scenario": cfg.arena.scenario, "decision_turns": cfg.arena.decision_turns,
+                    "fire_power_actions": False, "target": cfg.arena.target, "engine": "robocode"})
+        figures = session_plots(run.plots, sessions, cfg.name, cfg.train.session_rounds)
+        return {"scenario": cfg.arena.scenario, "learner": self.acting.diagnostics(),
+                "figures": [str(f) for f in figures], "replay": None, "n_actions": N_MOVES,
+                "n_features": self.obs_cfg.n_features, **self.info, "battles": self.battles,
+                "cpu_constant_ms": self.cpu_constant_ms, "updates": self.policy.updates,
+                "skipped_turns": self.skipped_turns, "bridge_failures": self.failures, "bridge_errors": self.errors,
+                "rtt_mean_us": self.rtt_sum_us / self.rtt_battles if self.rtt_battles else None,
+                "engine_setup_s": self.engine_setup_s}
+
+    def close(self) -> None:
+        self._tmp.cleanup()

@@ -208,6 +208,11 @@ class PPO:
         self.n_features = n_features
         self.updates = 0
 
+    def close(self) -> None:
+        """Stop the update thread of ``overlap`` (acting still works; updating does not)."""
+        if self._worker is not None:
+            self._worker.shutdown(wait=True)
+
     @property
     def n_actions(self) -> int:
         """Joint actions."""

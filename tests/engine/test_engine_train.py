@@ -15,7 +15,7 @@ from confront.checkpoint import CheckpointError
 from confront.experiments import train_engine
 from confront.experiments.spec import load_experiment
 from confront.experiments.train import load_model, save_model, td_learner, train_run
-from confront.experiments.train_engine import ENGINE_PARTS, round_rows, train_in_engine
+from confront.experiments.train_engine import ENGINE_PARTS, round_rows
 from confront.learning.tabular import TabularParams, TabularQ
 from confront.results import parse_results_text
 
@@ -68,7 +68,7 @@ def test_bad_config_is_refused_before_anything_runs(tmp_path: Path, override: st
                                                     match: str) -> None:
     with pytest.raises(error, match=match):  # a scenario file or robot that does not exist: already on load
         cfg = load_experiment("demo", ["train.rounds=2", "train.session_rounds=1", override])
-        train_in_engine(cfg, tmp_path / "run", progress=False)
+        train_run(cfg, tmp_path / "run", progress=False, engine="robocode")
     assert not (tmp_path / "run").exists()
 
 
@@ -91,7 +91,7 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path,
 
     monkeypatch.setattr(train_engine, "run_bridged_battle", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        train_in_engine(cfg, out, progress=False)
+        train_run(cfg, out, progress=False, engine="robocode")
     monkeypatch.setattr(train_engine, "run_bridged_battle", real)
     with open(out / "metrics" / "rounds.csv") as f:
         first = list(csv.DictReader(f))
@@ -99,7 +99,7 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path,
     _, meta = ck.load(ck.latest(out / "checkpoints"))
     assert meta["rounds_done"] == 2 and meta["battles"] == 1 and meta["updates"] > 0
 
-    summary = train_in_engine(None, out, progress=False, resume=True)
+    summary = train_run(None, out, progress=False, resume=True, engine="robocode")
     with open(out / "metrics" / "rounds.csv") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == rounds and [int(r["round"]) for r in rows] == [1, 2, 3]
@@ -140,8 +140,8 @@ def test_engine_resume_refuses_a_simulator_checkpoint(tmp_path: Path) -> None:
                                    "train.rounds=4", "train.session_rounds=1", "train.checkpoint_every=2",
                                    "train.replay=false", "arena.battles=1"])
     train_run(cfg, tmp_path / "run", progress=False)
-    with pytest.raises(CheckpointError, match="simulator checkpoint"):
-        train_in_engine(None, tmp_path / "run", progress=False, resume=True)
+    with pytest.raises(CheckpointError, match="--engine sim"):
+        train_run(None, tmp_path / "run", progress=False, resume=True, engine="robocode")
 
 
 @pytest.mark.engine
@@ -159,7 +159,7 @@ def test_team_trains_against_exported_td_team_with_transfer(install, tmp_path: P
                                    "train.session_rounds=1", "arena.decision_turns=10", "opponent.kind=td",
                                    f"opponent.model={tmp_path / 'td'}", f"transfer.source={tmp_path / 'src'}",
                                    "transfer.epsilon0=1.0", "transfer.floor=1.0", "transfer.init_from_source=false"])
-    summary = train_in_engine(cfg, tmp_path / "run", progress=False)
+    summary = train_run(cfg, tmp_path / "run", progress=False, engine="robocode")
     with open(tmp_path / "run" / "metrics" / "rounds.csv") as f:
         (row,) = list(csv.DictReader(f))
     assert int(row["alive_ours"]) <= 4 and int(row["alive_theirs"]) <= 4

@@ -10,7 +10,8 @@ from confront import checkpoint as ck
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.tank import OWN_FEATURES, TankSpace, action_table, lead_point, tank_view_row
 from confront.experiments.spec import load_experiment
-from confront.experiments.tanks import TankTrainer, evaluate_tanks, share_by_opponent, train_tanks
+from confront.experiments.tanks import TankTrainer, evaluate_tanks, share_by_opponent
+from confront.experiments.train import new_run, train_run
 from confront.runs import Run
 
 
@@ -102,14 +103,14 @@ def test_training_against_sittingduck_learns(tmp_path, overlap: str) -> None:
 def test_resume_after_a_kill_is_exact(tmp_path, overlap: str) -> None:
     cfg = _cfg(tmp_path, "1v1:SpinBot,4v4:dodge", ckpt="6", **{"league.battles": "2", "train.rounds": "14",
                                                               "ppo.overlap": overlap})
-    full = train_tanks(cfg, Run.create(tmp_path / "full", {}), progress=False)
-    part = Run.create(tmp_path / "part", {})
+    full = train_run(cfg, tmp_path / "full", progress=False)
+    part = new_run(cfg, tmp_path / "part")
     trainer = TankTrainer(cfg)
     while trainer.rounds_done < 6:
         trainer.update()
     arrays, meta = trainer.state()
     ck.save(part.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)  # then the process "dies"
-    resumed = train_tanks(cfg, part, resume=True, progress=False)
+    resumed = train_run(None, part.path, resume=True, progress=False)
     assert resumed["rounds"] == full["rounds"]
     a, b = Run(tmp_path / "full").read_table("rounds"), Run(tmp_path / "part").read_table("rounds")
     assert [r["score_ours"] for r in a] == [r["score_ours"] for r in b]

@@ -124,3 +124,33 @@ def test_random_reference_and_true_sensing_are_config_choices(tmp_path: Path,
     # a different sensing trains (and caches) a different TD team
     again = train_run(load_experiment("demo", small + ["learner.kind=random"]), tmp_path / "run2", progress=False)
     assert again["td_model"] != summary["td_model"]
+
+
+def test_one_loop_logs_every_learner_to_tensorboard(reference: tuple[Path, Path]) -> None:
+    """The paper's learners go through the same loop as PPO tanks: TensorBoard scalars of the score share."""
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    _, run = reference
+    acc = EventAccumulator(str(run / "tb"))
+    acc.Reload()
+    shares = acc.Scalars("share/all")
+    assert "train/temperature" in acc.Tags()["scalars"] and len(shares) >= 6
+    rows = _rows(run)
+    o = sum(float(r["score_ours"]) for r in rows[-8:])
+    t = sum(float(r["score_theirs"]) for r in rows[-8:])
+    assert shares[-1].value == pytest.approx(o / (o + t), rel=1e-6)  # the last 8 rounds (session_rounds), pooled
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["engine"] == "sim" and summary["setup_s"] >= 0
+
+
+def test_ppo_in_the_engine_is_refused_before_a_run_folder_is_left(tmp_path: Path) -> None:
+    from confront.config import ConfigError
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.train import train_run
+
+    with pytest.raises(ConfigError, match="PPO tanks train in the simulator"):
+        train_run(load_experiment("tanks-demo"), tmp_path / "run", progress=False, engine="robocode")
+    assert not (tmp_path / "run").exists()
+    with pytest.raises(ConfigError, match="engine must be one of"):
+        train_run(load_experiment("demo"), tmp_path / "run", progress=False, engine="gazebo")
+    assert not (tmp_path / "run").exists()

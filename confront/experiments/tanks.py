@@ -326,6 +326,7 @@ class TankTrainer:
 
         cfg = self.cfg
         run.write_table("updates", self.updates)
+        self.ppo.adopt_average()  # with ppo.ema_decay the model plays the averaged actor
         save_tank_model(run.path / "model", self.ppo, cfg, {"trained_rounds": len(rows)})
         figs = session_plots(run.plots, sessions, cfg.name, cfg.train.session_rounds)
         per: dict[str, list[float]] = {}

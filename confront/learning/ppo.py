@@ -64,6 +64,7 @@ class PPOConfig:
     team_critic: bool = True
     threads: int = 1  # torch threads: 1 beside the simulator's threads (more spin-waits on a busy machine)
     overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
+    ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
 
     def __post_init__(self) -> None:
         if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:
@@ -72,6 +73,8 @@ class PPOConfig:
             v = getattr(self, name)
             if not isinstance(v, int) or v < 1:
                 raise ValueError(f"ppo.{name} must be an integer >= 1, got {v!r}")
+        if not 0 <= self.ema_decay < 1:
+            raise ValueError(f"ppo.ema_decay must be in [0, 1), got {self.ema_decay!r}")
         for name, lo, hi in (("gamma", 0, 1), ("gae_lambda", 0, 1), ("clip", 0, 10)):
             v = getattr(self, name)
             if not lo <= v <= hi:
@@ -204,6 +207,7 @@ class PPO:
         self.acting = copy.deepcopy(self.net) if self.config.overlap else self.net  # the behaviour policy
         self._worker = ThreadPoolExecutor(1, thread_name_prefix="ppo-update") if self.config.overlap else None
         self._job: Future[dict[str, float]] | None = None
+        self.ema = copy.deepcopy(self.net.actor) if self.config.ema_decay > 0 else None  # the averaged actor
         self.dims = self.net.dims
         self.n_features = n_features
         self.updates = 0
@@ -326,10 +330,20 @@ class PPO:
                 stats["entropy"] += float(entropy.detach())
                 count += 1
         self.updates += 1
+        if self.ema is not None:  # Polyak averaging: ema <- d ema + (1 - d) actor
+            with torch.no_grad():
+                for pe, p in zip(self.ema.parameters(), self.net.actor.parameters(), strict=True):
+                    pe.mul_(c.ema_decay).add_(p, alpha=1 - c.ema_decay)
         out = {k: v / count for k, v in stats.items()}
         out["explained_variance"] = float(1 - np.var(ret.reshape(-1)[m] - ro.value.reshape(-1)[m])
                                           / (np.var(ret.reshape(-1)[m]) + 1e-12))
         return out
+
+    def adopt_average(self) -> None:
+        """Make the averaged actor (``ema_decay``) the actor: the policy a finished run saves and plays."""
+        if self.ema is not None:
+            self.net.actor.load_state_dict(self.ema.state_dict())
+            self._sync_acting()
 
     # -- data-only state ---------------------------------------------------------------------------------
     def actor_arrays(self) -> dict[str, np.ndarray]:
@@ -364,6 +378,8 @@ class PPO:
         d["gen"] = self.gen.get_state().numpy().copy()
         d["act_gen"] = self.act_gen.get_state().numpy().copy()
         d["updates"] = np.asarray(self.updates)
+        if self.ema is not None:
+            d.update({f"ema.{k}": v.detach().numpy().copy() for k, v in self.ema.state_dict().items()})
         return d
 
     def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
@@ -385,4 +401,7 @@ class PPO:
         if "act_gen" in d:  # models saved before acting had its own stream keep the seed's
             self.act_gen.set_state(torch.from_numpy(np.asarray(d["act_gen"], dtype=np.uint8)))
         self.updates = int(d["updates"])
+        if self.ema is not None:  # a model saved without the average starts it from its actor
+            ema = {k[4:]: torch.from_numpy(np.array(v)) for k, v in d.items() if k.startswith("ema.")}
+            self.ema.load_state_dict(ema or self.net.actor.state_dict())
         self._sync_acting()

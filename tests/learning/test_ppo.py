@@ -128,3 +128,25 @@ def test_entropy_coefficient_anneals_linearly() -> None:
     assert entropy_coef(PPOConfig(ent_coef=0.03), 10_000) == 0.03  # off by default
     with pytest.raises(ValueError, match="ent_anneal_updates"):
         PPOConfig(ent_anneal_updates=-1)
+
+
+def test_polyak_average_of_the_actor_hand_computed() -> None:
+    """ema_decay = d: after updates 1 and 2 the average is d^2 w0 + d(1-d) w1 + (1-d) w2; it resumes from its
+    state and a finished run adopts it as its actor."""
+    rng = np.random.default_rng(4)
+    d = 0.5
+    ppo = PPO(2, (2, 3), PPOConfig(hidden=8, lr=1e-2, team_critic=False, ema_decay=d), seed=1)
+    ws = [ppo.actor_arrays()]
+    for _ in range(2):
+        ppo.update(_bandit_rollout(ppo, rng))
+        ws.append(ppo.actor_arrays())
+    expected = {k: d * d * ws[0][k] + d * (1 - d) * ws[1][k] + (1 - d) * ws[2][k] for k in ws[0]}
+    assert not np.allclose(ws[2]["w0"], expected["w0"], atol=1e-4)  # the average is not the last actor
+    copy = PPO(2, (2, 3), PPOConfig(hidden=8, team_critic=False, ema_decay=d), seed=9)
+    copy.load_state_dict(ppo.state_dict())
+    for p in (ppo, copy):
+        p.adopt_average()
+        for k, v in p.actor_arrays().items():
+            np.testing.assert_allclose(v, expected[k], rtol=1e-5, atol=1e-6, err_msg=k)
+    with pytest.raises(ValueError, match="ppo.ema_decay"):
+        PPOConfig(ema_decay=1.0)

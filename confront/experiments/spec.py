@@ -163,6 +163,8 @@ class PPOSection:
     team_critic: bool = field(True, doc="the critic also sees the mean view of the tank's team (MAPPO-style)")
     overlap: bool = field(False, doc="update on a second thread while the next rollout is collected (acting one "
                           "update behind, decoupled PPO); false: collect, then update (docs/learning.md)")
+    ema_decay: float = field(0.0, ge=0.0, lt=1.0, doc="> 0: a Polyak average of the actor after each update "
+                             "(decay per update), the policy the finished run saves and plays; 0: the last actor")
 
 
 @dataclass

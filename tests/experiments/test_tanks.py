@@ -190,3 +190,13 @@ def test_bad_tank_configs_are_one_line_errors(tmp_path, override: str, message: 
                            "--out", str(tmp_path / "run")], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and message in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "run").exists()
+
+
+def test_polyak_average_is_a_config_key() -> None:
+    from confront.config import ConfigError
+    from confront.experiments.tanks import ppo_config
+
+    assert ppo_config(load_experiment("tanks-demo", ["ppo.ema_decay=0.95"])).ema_decay == 0.95
+    assert ppo_config(load_experiment("tanks")).ema_decay == load_experiment("tanks").ppo.ema_decay
+    with pytest.raises(ConfigError, match="ema_decay"):
+        load_experiment("tanks-demo", ["ppo.ema_decay=1.0"])

@@ -78,7 +78,8 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
     if arm == "ssaq":
         sets.append("learner.kind=ssaq")
     cfg = load_experiment("awm", sets)
-    loop = SMDPTrainer(cfg).loop
+    trainer = SMDPTrainer.from_config(cfg)
+    loop = trainer.loop
     n_actions = loop.env.n_actions
     if learner_params and arm in ("dmnn", "frozen"):
         lr = loop.side.learner
@@ -126,7 +127,7 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
         return res
 
     loop.env.step = step  # type: ignore[method-assign]
-    run_rounds(loop, rounds, progress=False, desc=arm)
+    run_rounds(trainer, rounds, progress=False, desc=arm)
     ratio = np.array([s["score_ratio"] for s in session_rows(loop.rows[:rounds], 10)])
     return np.stack([ratio, reward[0] / np.maximum(reward[1], 1), reward[2] / np.maximum(reward[1], 1)])
 

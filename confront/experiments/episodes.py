@@ -42,7 +42,7 @@ from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
 __all__ = ["scenario_of", "smdp_config", "build_learner", "td_learner", "save_model", "load_model", "Side", "Loop",
-           "SMDPTrainer", "td_team", "run_rounds", "record_round"]
+           "SMDPTrainer", "td_team", "run_rounds", "pooled_share", "record_round"]
 
 
 # -- building blocks ---------------------------------------------------------------------------------------------
@@ -243,27 +243,31 @@ class Loop:
 
 
 class SMDPTrainer:
-    """The paper's learners in the simulator as a trainer of ``train.train_run``: one SMDP step of every battle
-    per ``advance`` (the learner vs scripted robots or the TD team, curriculum transfer as configured)."""
+    """The paper's learners in the simulator as a trainer of the one training loop (:func:`run_rounds`,
+    ``train.train_run``): one SMDP step of every battle per ``advance``. :meth:`from_config` builds a config's
+    (the learner vs scripted robots or the TD team, curriculum transfer as configured)."""
 
     engine = "sim"
     bar_scalars = {"temperature": "T"}
     final_window = 100
 
-    def __init__(self, cfg: ExperimentConfig, progress: bool = False) -> None:
-        self.cfg = cfg
+    def __init__(self, loop: Loop, desc: str, cfg: ExperimentConfig | None = None,
+                 info: dict[str, Any] | None = None) -> None:
+        self.loop, self.desc, self.cfg, self.info = loop, desc, cfg, info or {}
+
+    @classmethod
+    def from_config(cls, cfg: ExperimentConfig, progress: bool = False) -> SMDPTrainer:
         scenario = scenario_of(cfg.arena.scenario)
         env = TeamBattleEnv(scenario, n_battles=cfg.arena.battles, seed=cfg.train.seed, opponents=cfg.opponent.kind,
                             config=smdp_config(cfg))
         team = env.team_ids()
         learner = build_learner(cfg, env.n_features, env.n_actions)
-        self.info: dict[str, Any] = {"scenario": scenario.name, "n_actions": env.n_actions,
-                                     "n_features": env.n_features}
+        info: dict[str, Any] = {"scenario": scenario.name, "n_actions": env.n_actions, "n_features": env.n_features}
         side = Side(learner, ours=team == 0)
         if cfg.opponent.kind == "td":
             td, where = td_team(cfg, env.n_actions, progress=progress)
             side.opponent, side.theirs, side.opponent_learns = td, team != 0, cfg.opponent.learning
-            self.info["td_model"] = str(where)
+            info["td_model"] = str(where)
         if cfg.transfer.source:
             source, _ = load_model(cfg.transfer.source)
             if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
@@ -274,9 +278,8 @@ class SMDPTrainer:
                 learner.load_state_dict(source.state_dict())
             tc = cfg.transfer
             side.learner = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
-            self.info["transfer_source"] = cfg.transfer.source
-        self.loop = Loop(env, side, seed=cfg.train.seed)
-        self.desc = f"{cfg.name} {scenario.name}"
+            info["transfer_source"] = cfg.transfer.source
+        return cls(Loop(env, side, seed=cfg.train.seed), f"{cfg.name} {scenario.name}", cfg, info)
 
     @property
     def rows(self) -> list[dict[str, Any]]:
@@ -312,6 +315,8 @@ class SMDPTrainer:
         from confront.experiments.plots import session_plots
 
         cfg, side = self.cfg, self.loop.side
+        if cfg is None:
+            raise ValueError("finish needs the trainer's config (SMDPTrainer.from_config)")
         save_model(run.path / "model", side.learner,
                    {"scenario": self.info["scenario"], "decision_turns": cfg.arena.decision_turns,
                     "fire_power_actions": cfg.arena.fire_power_actions, "target": cfg.arena.target})
@@ -355,36 +360,46 @@ def td_team(cfg: ExperimentConfig, n_actions: int, progress: bool = False) -> tu
         env = TeamBattleEnv(get_scenario("4v4"), n_battles=8, seed=cfg.train.seed + 7919,
                             opponents=oc.pretrain_against, config=smdp_config(cfg))
         loop = Loop(env, Side(learner, ours=env.team_ids() == 0), seed=cfg.train.seed + 7919)
-        run_rounds(loop, oc.pretrain_rounds, progress=progress, desc="TD team pre-training")
+        run_rounds(SMDPTrainer(loop, "TD team pre-training"), oc.pretrain_rounds, progress=progress)
     save_model(cache, learner, {"trained_rounds": oc.pretrain_rounds, "against": oc.pretrain_against})
     return learner, cache
 
 
-def run_rounds(loop: Loop, rounds: int, progress: bool, desc: str, on_rounds: Any = None, session: int = 10) -> None:
+def pooled_share(rows: list[dict[str, Any]]) -> float:
+    """Our score over both sides' (pooled over ``rows``; 0.5 when nobody scored)."""
+    o = sum(r["score_ours"] for r in rows)
+    t = sum(r["score_theirs"] for r in rows)
+    return o / (o + t) if o + t > 0 else 0.5
+
+
+def run_rounds(trainer: Any, rounds: int, progress: bool, desc: str | None = None, on_step: Any = None,
+               window: int = 10) -> None:
+    """The one training loop: ``trainer.advance`` until ``rounds`` rounds are done (any trainer of
+    ``train.Trainer``), with a progress bar (the share of the last ``window`` rounds and the trainer's
+    ``bar_scalars``); ``on_step(scalars)`` after every step in which rounds ended."""
     from tqdm import tqdm
 
-    bar = tqdm(total=rounds, initial=min(loop.rounds_done, rounds), desc=desc, unit="round", disable=not progress,
-               dynamic_ncols=True, leave=True)
+    bar = tqdm(total=rounds, initial=min(trainer.rounds_done, rounds), desc=desc or trainer.desc, unit="round",
+               disable=not progress, dynamic_ncols=True)
+
+    def tick(done: int) -> None:
+        bar.update(min(done, rounds) - bar.n)
+
     try:
-        while loop.rounds_done < rounds:
-            ended = loop.step()
-            if not ended:
+        while trainer.rounds_done < rounds:
+            before = trainer.rounds_done
+            scalars = trainer.advance(rounds, tick)
+            if trainer.rounds_done == before:
                 continue
-            loop.rows.extend(ended)
-            if len(loop.rows) > rounds:
-                del loop.rows[rounds:]
-                loop.rounds_done = rounds
-            bar.update(min(loop.rounds_done, rounds) - bar.n)
-            recent = loop.rows[-session:]
-            o = sum(r["score_ours"] for r in recent)
-            t = sum(r["score_theirs"] for r in recent)
-            diag = loop.side.learner.diagnostics()
-            bar.set_postfix(score_ratio=f"{o / (o + t) if o + t else 0.5:.3f}",
-                            T=f"{diag.get('temperature', 0):.3f}", refresh=False)
-            if on_rounds is not None:
-                on_rounds(loop)
+            tick(trainer.rounds_done)
+            bar.set_postfix(share=f"{pooled_share(trainer.rows[-window:]):.3f}", refresh=False,
+                            **{label: f"{scalars[k]:,.0f}" if abs(scalars[k]) >= 100 else f"{scalars[k]:.3f}"
+                               for k, label in trainer.bar_scalars.items() if k in scalars})
+            if on_step is not None:
+                on_step(scalars)
     finally:
         bar.close()
+
 
 def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | None = None) -> str | None:
     """One greedy round of the trained team in a single fresh battle, as replay JSON + GIF + HTML."""

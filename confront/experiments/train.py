@@ -6,7 +6,8 @@ A :class:`Trainer` plays and learns in steps and holds all it changes as data. T
 :class:`~confront.experiments.episodes.SMDPTrainer` (the paper's learners in the simulator),
 :class:`~confront.experiments.tanks.TankTrainer` (PPO tanks in the simulator's league) and
 :class:`~confront.experiments.train_engine.EngineTrainer` (the paper's learners live in Robocode, one battle
-per step). :func:`train_run` is the loop around them, the same for all three: resume, progress bar,
+per step). One loop advances them all, :func:`~confront.experiments.episodes.run_rounds` (also the TD team's
+pre-training); :func:`train_run` wraps it in a run folder, the same for all three: resume, progress bar,
 TensorBoard scalars (``tb/``), checkpoints every ``train.checkpoint_every`` rounds, then the run's tables,
 summary and figures.
 
@@ -35,6 +36,7 @@ from confront.experiments.episodes import (  # the building blocks, re-exported 
     SMDPTrainer,
     build_learner,
     load_model,
+    pooled_share,
     record_round,
     run_rounds,
     save_model,
@@ -98,7 +100,7 @@ def make_trainer(cfg: ExperimentConfig, run: Run, engine: str = "sim", progress:
         from confront.experiments.train_engine import EngineTrainer
 
         return EngineTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
-    return SMDPTrainer(cfg, progress=progress)
+    return SMDPTrainer.from_config(cfg, progress=progress)
 
 
 # -- run folders -------------------------------------------------------------------------------------------------
@@ -143,19 +145,13 @@ def new_run(cfg: ExperimentConfig, out: str | Path | None, exist_ok: bool = Fals
                       exist_ok=exist_ok)
 
 
-def _pooled(rows: list[dict[str, Any]]) -> float:
-    o = sum(r["score_ours"] for r in rows)
-    t = sum(r["score_theirs"] for r in rows)
-    return o / (o + t) if o + t > 0 else 0.5
-
-
 def _log(writer: Any, trainer: Trainer, scalars: dict[str, float], window: int) -> None:
     """TensorBoard scalars at the trainer's decision count: score share (overall, per opponent) and the step's."""
     step = trainer.decisions
     recent = trainer.rows[-window:]
-    writer.add_scalar("share/all", _pooled(recent), step)
+    writer.add_scalar("share/all", pooled_share(recent), step)
     for name in sorted({r["opponent"] for r in recent if "opponent" in r}):
-        writer.add_scalar(f"share/{name}", _pooled([r for r in recent if r.get("opponent") == name]), step)
+        writer.add_scalar(f"share/{name}", pooled_share([r for r in recent if r.get("opponent") == name]), step)
     for k, v in scalars.items():
         if isinstance(v, int | float) and math.isfinite(v):
             writer.add_scalar(f"train/{k}", v, step)
@@ -186,7 +182,6 @@ def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool
 def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, progress: bool,
            setup_s: float) -> dict[str, Any]:
     from torch.utils.tensorboard import SummaryWriter
-    from tqdm import tqdm
 
     elapsed_before = 0.0
     if resume and (latest := ck.latest(run.checkpoints)) is not None:
@@ -201,33 +196,21 @@ def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, prog
     tc = cfg.train
     total, every, window = tc.rounds, tc.checkpoint_every, min(tc.session_rounds, 200)
     start = time.time()
-    next_ckpt = (trainer.rounds_done // every + 1) * every
-    bar = tqdm(total=total, initial=min(trainer.rounds_done, total), desc=trainer.desc, unit="round",
-               disable=not progress, dynamic_ncols=True)
+    next_ckpt = [(trainer.rounds_done // every + 1) * every]
     writer = SummaryWriter(str(run.path / "tb"))
 
-    def tick(rounds: int) -> None:
-        bar.update(min(rounds, total) - bar.n)
+    def on_step(scalars: dict[str, float]) -> None:
+        _log(writer, trainer, scalars, window)
+        if next_ckpt[0] <= trainer.rounds_done < total:
+            arrays, meta = trainer.state()
+            meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start)
+            ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
+            run.write_table("rounds", trainer.rows)
+            next_ckpt[0] = (trainer.rounds_done // every + 1) * every
 
     try:
-        while trainer.rounds_done < total:
-            before = trainer.rounds_done
-            scalars = trainer.advance(total, tick)
-            if trainer.rounds_done == before:
-                continue
-            tick(trainer.rounds_done)
-            bar.set_postfix(share=f"{_pooled(trainer.rows[-window:]):.3f}", refresh=False,
-                            **{label: f"{scalars[k]:,.0f}" if abs(scalars[k]) >= 100 else f"{scalars[k]:.3f}"
-                               for k, label in trainer.bar_scalars.items() if k in scalars})
-            _log(writer, trainer, scalars, window)
-            if next_ckpt <= trainer.rounds_done < total:
-                arrays, meta = trainer.state()
-                meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start)
-                ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
-                run.write_table("rounds", trainer.rows)
-                next_ckpt = (trainer.rounds_done // every + 1) * every
+        run_rounds(trainer, total, progress, on_step=on_step, window=window)
     finally:
-        bar.close()
         writer.close()
     rows = trainer.rows
     sessions = session_rows(rows, tc.session_rounds)
@@ -237,7 +220,7 @@ def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, prog
     summary: dict[str, Any] = {
         "name": cfg.name, "run": str(run.path), "engine": trainer.engine, "rounds": len(rows),
         "sessions": len(sessions), "decisions": trainer.decisions,
-        "final_score_ratio": _pooled(tail), "final_window_rounds": len(tail),
+        "final_score_ratio": pooled_share(tail), "final_window_rounds": len(tail),
         "first_session_ratio": sessions[0]["score_ratio"] if sessions else math.nan,
         "last_session_ratio": sessions[-1]["score_ratio"] if sessions else math.nan,
         "win_rate_last": sum(r["won"] for r in tail) / max(1, len(tail)),

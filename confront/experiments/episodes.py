@@ -42,7 +42,7 @@ from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
 __all__ = ["scenario_of", "smdp_config", "build_learner", "td_learner", "save_model", "load_model", "Side", "Loop",
-           "SMDPTrainer", "td_team", "run_rounds", "pooled_share", "record_round"]
+           "SMDPTrainer", "with_transfer", "td_team", "run_rounds", "pooled_share", "record_round"]
 
 
 # -- building blocks ---------------------------------------------------------------------------------------------
@@ -242,6 +242,23 @@ class Loop:
             self.last_learn = out
 
 
+def with_transfer(cfg: ExperimentConfig, learner: Learner) -> tuple[Learner, dict[str, Any]]:
+    """Curriculum transfer (``transfer.source``): the learner wrapped to act from the source model with Eq. 34's
+    epsilon (and started from its weights with ``init_from_source``); the learner itself when there is none."""
+    tc = cfg.transfer
+    if not tc.source:
+        return learner, {}
+    source, _ = load_model(tc.source)
+    if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
+        raise ck.CheckpointError(
+            f"transfer.source {tc.source} has {source.n_actions} actions on {source.observation} observations; "
+            f"this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
+    if tc.init_from_source:
+        learner.load_state_dict(source.state_dict())
+    return TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor)), \
+        {"transfer_source": tc.source}
+
+
 class SMDPTrainer:
     """The paper's learners in the simulator as a trainer of the one training loop (:func:`run_rounds`,
     ``train.train_run``): one SMDP step of every battle per ``advance``. :meth:`from_config` builds a config's
@@ -268,17 +285,8 @@ class SMDPTrainer:
             td, where = td_team(cfg, env.n_actions, progress=progress)
             side.opponent, side.theirs, side.opponent_learns = td, team != 0, cfg.opponent.learning
             info["td_model"] = str(where)
-        if cfg.transfer.source:
-            source, _ = load_model(cfg.transfer.source)
-            if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
-                raise ck.CheckpointError(
-                    f"transfer.source {cfg.transfer.source} has {source.n_actions} actions on {source.observation} "
-                    f"observations; this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
-            if cfg.transfer.init_from_source:
-                learner.load_state_dict(source.state_dict())
-            tc = cfg.transfer
-            side.learner = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
-            info["transfer_source"] = cfg.transfer.source
+        side.learner, transfer_info = with_transfer(cfg, learner)
+        info.update(transfer_info)
         return cls(Loop(env, side, seed=cfg.train.seed), f"{cfg.name} {scenario.name}", cfg, info)
 
     @property

@@ -114,11 +114,10 @@ def session_rows(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
     last = [k for k in ("decisions", "wall_s") if rows and k in rows[0]]
     for start in range(0, len(rows) - size + 1, size):
         chunk = rows[start:start + size]
-        o = sum(r["score_ours"] for r in chunk)
-        t = sum(r["score_theirs"] for r in chunk)
-        ratio = o / (o + t) if o + t > 0 else 0.5
+        ratio = pooled_share(chunk)
         out.append({
-            "session": len(out) + 1, "rounds": len(chunk), "score_ours": o, "score_theirs": t,
+            "session": len(out) + 1, "rounds": len(chunk), "score_ours": sum(r["score_ours"] for r in chunk),
+            "score_theirs": sum(r["score_theirs"] for r in chunk),
             "score_ratio": ratio,
             "fluctuation": ratio - out[-1]["score_ratio"] if out else 0.0,  # Fig. 11: first difference
             "win_rate": sum(r["won"] for r in chunk) / len(chunk),

@@ -41,10 +41,8 @@ from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.install import find_engine
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
-from confront.experiments.episodes import build_learner, load_model, save_model, td_team
+from confront.experiments.episodes import build_learner, save_model, td_team, with_transfer
 from confront.experiments.spec import ExperimentConfig
-from confront.learning.base import Learner
-from confront.learning.transfer import TransferParams, TransferPolicy
 from confront.runs import Run
 
 __all__ = ["EngineTrainer", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
@@ -130,22 +128,6 @@ def _check(cfg: ExperimentConfig) -> None:
             raise ConfigError(f"opponent.kind: {exc}") from None
 
 
-def _transfer(cfg: ExperimentConfig, learner: Learner) -> tuple[Learner, dict[str, Any]]:
-    """Curriculum transfer as in the simulator: the learner wrapped to act from the source with Eq. 34's eps."""
-    tc = cfg.transfer
-    if not tc.source:
-        return learner, {}
-    source, _ = load_model(tc.source)
-    if (source.n_actions, source.observation) != (learner.n_actions, learner.observation):
-        raise CheckpointError(
-            f"transfer.source {tc.source} has {source.n_actions} actions on {source.observation} observations; "
-            f"this task needs {learner.n_actions} on {learner.observation} (Eq. 33)")
-    if tc.init_from_source:
-        learner.load_state_dict(source.state_dict())
-    wrapped = TransferPolicy(learner, source, TransferParams(tc.epsilon0, tc.decay, 0, tc.floor))
-    return wrapped, {"transfer_source": tc.source}
-
-
 class _Progress:
     """Bridge policy wrapper that reports rounds as they start (``done`` rounds before this battle) to ``tick``."""
 
@@ -183,7 +165,7 @@ class EngineTrainer:
         self.cpu_constant_ms = BRIDGE_CPU_CONSTANT_MS if cpu_constant_ms is None else cpu_constant_ms
         self.obs_cfg = ObservationConfig(target=cfg.arena.target)
         self.learner = build_learner(cfg, self.obs_cfg.n_features, N_MOVES)
-        self.acting, self.info = _transfer(cfg, self.learner)
+        self.acting, self.info = with_transfer(cfg, self.learner)
         self.policy = LearnerPolicy(self.acting, np.random.default_rng([cfg.train.seed, 0]), train=True,
                                     explore=True, observation=self.obs_cfg, step_turns=cfg.arena.decision_turns)
         self.rows: list[dict[str, Any]] = []

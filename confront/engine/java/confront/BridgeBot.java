@@ -615,10 +615,6 @@ public class BridgeBot extends TeamRobot {
         finished = true;
         if (!failed && socket != null) {
             try {
-                if (pending) {
-                    in.readLine();  // the answer to a request sent ahead (lead): closing with it unread resets
-                    pending = false;
-                }
                 // with this round's round-trip and work-time statistics (a dead robot's output is not collected)
                 if (keepHistory) {
                     record();  // the state this robot ends the round in
@@ -628,8 +624,14 @@ public class BridgeBot extends TeamRobot {
                         in.readLine();  // updates not yet read: closing with them unread resets the connection
                     }
                 }
+                // sent before any blocking read: after the battle's last round the engine stops a robot that
+                // takes too long in its handlers, and the end line must be out by then
                 send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy() + " " + rttN + " "
                         + rttSum / 1000 + " " + rttSlow + " " + turnsPlayed + " " + workNanos / 1000 + "\t" + history);
+                if (pending) {
+                    in.readLine();  // the answer to a request sent ahead (lead): closing with it unread resets
+                    pending = false;
+                }
             } catch (IOException e) {
                 // the round is over anyway
             }

@@ -165,6 +165,8 @@ class PPOSection:
                           "update behind, decoupled PPO); false: collect, then update (docs/learning.md)")
     ema_decay: float = field(0.0, ge=0.0, lt=1.0, doc="> 0: a Polyak average of the actor after each update "
                              "(decay per update), the policy the finished run saves and plays; 0: the last actor")
+    anneal_lr: bool = field(False, doc="the Adam step falls linearly from lr to 0 over train.rounds (CleanRL's "
+                            "anneal_lr)")
 
 
 @dataclass

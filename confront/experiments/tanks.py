@@ -275,6 +275,7 @@ class TankTrainer:
         self._pick_snapshot()
         pending, self.pending = self.pending, None
         if pending is not None:
+            self.ppo.set_progress(self.rounds_done / self.cfg.train.rounds)
             self.ppo.start_update(pending)  # with overlap it returns at once
         t_up = time.perf_counter() - t0
         buf, t_env = self._collect()

@@ -40,7 +40,8 @@ from torch import nn
 IS_MAX = 2.0  # truncation of the behaviour -> proximal importance weight with ``overlap``
 UPDATE_STATS = ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance")
 
-__all__ = ["UPDATE_STATS", "entropy_coef", "PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean", "greedy_joint"]
+__all__ = ["UPDATE_STATS", "entropy_coef", "learning_rate", "PPOConfig", "ActorCritic", "PPO", "Rollout", "team_mean",
+           "greedy_joint"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,7 @@ class PPOConfig:
     threads: int = 1  # torch threads: 1 beside the simulator's threads (more spin-waits on a busy machine)
     overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
     ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
+    anneal_lr: bool = False  # the Adam step falls linearly from lr to 0 over the run (CleanRL's anneal_lr)
 
     def __post_init__(self) -> None:
         if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:
@@ -91,6 +93,12 @@ def entropy_coef(c: PPOConfig, updates: int) -> float:
         return c.ent_coef
     f = min(1.0, updates / c.ent_anneal_updates)
     return c.ent_coef + f * (c.ent_coef_end - c.ent_coef)
+
+
+def learning_rate(c: PPOConfig, progress: float) -> float:
+    """The Adam step at ``progress`` (the fraction of the run done, 0..1): lr, or with ``anneal_lr`` lr (1 -
+    progress), 0 from the run's end on."""
+    return c.lr * max(0.0, 1.0 - progress) if c.anneal_lr else c.lr
 
 
 def _done(value: dict[str, float]) -> Future[dict[str, float]]:
@@ -250,6 +258,12 @@ class PPO:
     def values(self, critic_in: np.ndarray) -> np.ndarray:
         """V of (N, C) critic inputs."""
         return self.acting.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+
+    def set_progress(self, progress: float) -> None:
+        """Tell the learner the fraction of the run done (0..1); with ``anneal_lr`` the next updates step by
+        :func:`learning_rate`."""
+        for group in self.opt.param_groups:
+            group["lr"] = learning_rate(self.config, progress)
 
     def start_update(self, ro: Rollout) -> None:
         """Begin :meth:`update` on ``ro``: on the worker thread with ``overlap`` (acting stays on the current

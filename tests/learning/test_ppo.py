@@ -150,3 +150,20 @@ def test_polyak_average_of_the_actor_hand_computed() -> None:
             np.testing.assert_allclose(v, expected[k], rtol=1e-5, atol=1e-6, err_msg=k)
     with pytest.raises(ValueError, match="ppo.ema_decay"):
         PPOConfig(ema_decay=1.0)
+
+
+def test_learning_rate_anneals_linearly_to_zero() -> None:
+    from confront.learning.ppo import learning_rate
+
+    c = PPOConfig(lr=2e-3, anneal_lr=True, hidden=8, team_critic=False)
+    assert learning_rate(c, 0.0) == 2e-3 and learning_rate(c, 0.25) == pytest.approx(1.5e-3)
+    assert learning_rate(c, 1.0) == 0.0 and learning_rate(c, 1.3) == 0.0  # rounds past the end: no step
+    assert learning_rate(PPOConfig(lr=2e-3), 0.9) == 2e-3  # off by default
+    ppo = PPO(2, (2, 3), c, seed=0)
+    ppo.set_progress(0.75)
+    assert [g["lr"] for g in ppo.opt.param_groups] == [pytest.approx(5e-4)]
+    before = {k: v.copy() for k, v in ppo.state_dict().items() if k.startswith("net.actor")}
+    ppo.set_progress(1.0)
+    ppo.update(_bandit_rollout(ppo, np.random.default_rng(0)))
+    for k, v in before.items():  # a zero step leaves the weights
+        np.testing.assert_array_equal(v, ppo.state_dict()[k], err_msg=k)

@@ -1,14 +1,17 @@
 """The report of the recommended learner: trained PPO tank runs, evaluated per opponent in the simulator and
 (the exported TankBot, no Python) in the real engine, against the issue's targets.
 
-    python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine [--unseen]]
-        [--compare WORK]
+    python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine [--unseen]
+        [--engine-runs K]] [--compare WORK]
 
 Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
 simulator share (``--rounds`` rounds, the mean over runs with a t-interval when there are 2 or more), and with
 ``--engine`` the exported robot's share in Robocode over ``--engine-seeds`` battles of ``--rounds`` rounds
-per sample-robot entry. Writes ``report.md``, ``results.json`` and the learning curves (share against
-decisions and against wall time, per opponent).
+per sample-robot entry, for the first run or the first ``--engine-runs`` runs (then also the mean of their
+run means with a t-interval, and how many runs reach the target). Engine battles are kept per run
+(``<run>/eval/engine-<rounds>.json``), so runs can be played by separate processes side by side first.
+Writes ``report.md``, ``results.json`` and the learning curves (share against decisions and against wall
+time, per opponent).
 """
 
 from __future__ import annotations
@@ -118,11 +121,13 @@ def greedy_shares(run: Path, cfg: Any, rounds: int) -> dict[str, float]:
 
 
 def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int, unseen: bool = False,
-           compare_work: Path | None = None, engine_from: Path | None = None) -> dict[str, Any]:
+           compare_work: Path | None = None, engine_from: Path | None = None, engine_runs: int = 1
+           ) -> dict[str, Any]:
     """Evaluate the runs and write the report; return the results (``unseen``: also the first run's exported
     robot in the engine against :data:`UNSEEN`, robots no league entry names; ``compare_work``: also the
     comparison with the baselines, :mod:`confront.experiments.tank_compare`, trained and cached there;
-    ``engine_from``: the engine rows of an earlier ``results.json`` of the same first run, instead of playing)."""
+    ``engine_from``: the engine rows of an earlier ``results.json`` of the same first run, instead of playing;
+    ``engine_runs``: how many of the runs, from the first, play in the engine)."""
     out.mkdir(parents=True, exist_ok=True)
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
     entries = list(cfgs[0].league.opponents)
@@ -132,14 +137,19 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
         for e in entries:
             sim[e].append(res[e])
     real: dict[str, list[float]] = {}
+    real_runs: dict[str, list[list[float]]] = {}  # per engine run, its battles
     if engine:
         from confront.arena.bots import BOT_NAMES
         from confront.engine.tank_export import load_tank_policy
 
         policy = load_tank_policy(runs[0])
-        for e in entries:
-            if e.partition(":")[2] in BOT_NAMES:
-                real[e] = [engine_share(runs[0], policy, e, rounds, k + 1) for k in range(engine_seeds)]
+        for i, run in enumerate(runs[:engine_runs]):
+            pol = policy if i == 0 else load_tank_policy(run)
+            for e in entries:
+                if e.partition(":")[2] in BOT_NAMES:
+                    real_runs.setdefault(e, []).append([engine_share(run, pol, e, rounds, k + 1)
+                                                        for k in range(engine_seeds)])
+        real = {e: v[0] for e, v in real_runs.items()}
     unseen_rows = []
     if engine_from is not None:
         earlier = json.loads(engine_from.read_text())
@@ -156,7 +166,9 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
     result = {"runs": [r.name for r in runs], "rounds": rounds,
               "engine_seeds": engine_seeds if engine or engine_from is not None else 0,
               "trained": [{k: s[k] for k in ("rounds", "wall_time_s", "decisions")} for s in summaries],
-              "rows": [{"entry": e, "sim": sim[e], "engine": real.get(e), "target": target_of(e)} for e in entries],
+              "engine_runs": [r.name for r in runs[:engine_runs]] if engine else [],
+              "rows": [{"entry": e, "sim": sim[e], "engine": real.get(e), "engine_runs": real_runs.get(e),
+                        "target": target_of(e)} for e in entries],
               "unseen": unseen_rows}
     if compare_work is not None:
         from confront.experiments.tank_compare import compare, compare_entries
@@ -186,22 +198,37 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
          "compares that same policy." if seeds else "Engine: not run (pass --engine)."),
         "Target: the issue's engine share for the entry; `met` compares the engine mean with it.",
         "",
-        f"| opponent | simulator, {len(runs)} seeds | simulator, {runs[0]} | engine, {runs[0]} (battles) | engine mean "
-        "| sim - engine | target | met |",
-        "|---|---:|---:|---:|---:|---:|---:|:---:|",
     ]
+    k_runs = len(result.get("engine_runs", []))
+    if k_runs > 1:
+        lines.insert(-2, f"Engine, {k_runs} runs ({', '.join(result['engine_runs'])}): each run's mean over its "
+                        f"{seeds} battles, then the mean of those and its 95% t-interval over runs; `runs met`: how "
+                        "many of the runs' engine means reach the target.")
+    extra = (f" engine, {k_runs} runs | runs met |", "---:|:---:|") if k_runs > 1 else ("", "")
+    lines += [f"| opponent | simulator, {len(runs)} seeds | simulator, {runs[0]} | engine, {runs[0]} (battles) | "
+              f"engine mean | sim - engine |{extra[0]} target | met |",
+              f"|---|---:|---:|---:|---:|---:|{extra[1]}---:|:---:|"]
     for row in result["rows"]:
         e, sim, r, tgt = row["entry"], row["sim"], row["engine"], row["target"]
         m, lo, hi = mean_interval(sim)
         s_txt = f"{m:.3f}" + (f" [{lo:.3f}, {hi:.3f}]" if not math.isnan(lo) else "")
         t_txt = "-" if tgt is None else f"{tgt:.2f}"
+        k_txt = ""
+        if k_runs > 1:
+            per_run = [float(np.mean(b)) for b in row.get("engine_runs") or []]
+            if per_run:
+                km, klo, khi = mean_interval(per_run)
+                n_met = "" if tgt is None else f"{sum(v >= tgt for v in per_run)}/{len(per_run)}"
+                k_txt = f" {km:.3f} [{klo:.3f}, {khi:.3f}] | {n_met} |"
+            else:
+                k_txt = " - | |"
         if r:
             em = float(np.mean(r))
             met = "" if tgt is None else ("yes" if em >= tgt else "no")
             lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | {' / '.join(f'{v:.3f}' for v in r)} | {em:.3f} | "
-                         f"{sim[0] - em:+.3f} | {t_txt} | {met} |")
+                         f"{sim[0] - em:+.3f} |{k_txt} {t_txt} | {met} |")
         else:
-            lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | - | - | - | {t_txt} | |")
+            lines.append(f"| {e} | {s_txt} | {sim[0]:.3f} | - | - | - |{k_txt} {t_txt} | |")
     if result.get("unseen"):
         n_b = len(result["unseen"][0]["engine"])
         lines += ["", f"Robots no league entry names (the first run's exported robot in the engine, {n_b} battle(s) of "
@@ -227,20 +254,22 @@ def main() -> None:
     ap.add_argument("--engine", action="store_true")
     ap.add_argument("--engine-seeds", type=int, default=3)
     ap.add_argument("--unseen", action="store_true", help="with --engine: also robots no league entry names")
+    ap.add_argument("--engine-runs", type=int, default=1, metavar="K",
+                    help="with --engine: play the first K runs in the engine (default: the first only)")
     ap.add_argument("--compare", type=Path, default=None, metavar="WORK",
                     help="also compare with the paper's method, SB3 PPO and random moves (baselines cached in WORK)")
     ap.add_argument("--engine-from", type=Path, default=None, metavar="RESULTS_JSON",
                     help="take the engine rows from an earlier results.json of the same first run")
     args = ap.parse_args()
-    if args.rounds < 1 or args.engine_seeds < 1:
-        ap.error("--rounds and --engine-seeds must be at least 1")
+    if args.rounds < 1 or args.engine_seeds < 1 or not 1 <= args.engine_runs <= len(args.runs):
+        ap.error("--rounds and --engine-seeds must be at least 1, --engine-runs between 1 and the number of runs")
     if args.engine_from is not None and args.engine:
         ap.error("--engine plays the battles, --engine-from reads them: give one")
     for r in args.runs:
         if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
             ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")
     res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds, args.unseen, args.compare,
-                 args.engine_from)
+                 args.engine_from, args.engine_runs)
     print((args.out / "report.md").read_text())
     print(json.dumps({"report": str(args.out / "report.md"), "entries": len(res["rows"])}))
 

@@ -200,3 +200,23 @@ def test_polyak_average_is_a_config_key() -> None:
     assert ppo_config(load_experiment("tanks-demo")).ema_decay == 0.0  # off unless a config asks for it
     with pytest.raises(ConfigError, match="ema_decay"):
         load_experiment("tanks-demo", ["ppo.ema_decay=1.0"])
+
+
+def test_report_engine_over_runs(tmp_path) -> None:
+    """--engine-runs: per entry the mean of the runs' engine means with its t-interval, and how many runs meet."""
+    from confront.experiments.tank_report import write_markdown
+
+    trained = [{"rounds": 10, "wall_time_s": 1.0, "decisions": 100}] * 3
+    result = {"runs": ["a", "b", "c"], "rounds": 10, "engine_seeds": 2, "trained": trained,
+              "engine_runs": ["a", "b", "c"], "unseen": [],
+              "rows": [{"entry": "1v1:Walls", "sim": [0.9, 0.95, 0.85], "engine": [0.92, 0.94],
+                        "engine_runs": [[0.92, 0.94], [0.88, 0.90], [0.95, 0.97]], "target": 0.90},
+                       {"entry": "1v1:self", "sim": [0.5, 0.5, 0.5], "engine": None, "engine_runs": None,
+                        "target": None}]}
+    md = write_markdown(result, tmp_path).read_text()
+    m = (0.93 + 0.89 + 0.96) / 3  # the runs' means
+    half = 4.302653 * math.sqrt(((0.93 - m) ** 2 + (0.89 - m) ** 2 + (0.96 - m) ** 2) / 2 / 3)  # t(0.975, 2) sem
+    row = next(line for line in md.splitlines() if line.startswith("| 1v1:Walls"))
+    assert f"| {m:.3f} [{m - half:.3f}, {m + half:.3f}] | 2/3 |" in row and row.endswith("| 0.90 | yes |")
+    assert "| engine, 3 runs | runs met |" in md and "Engine, 3 runs (a, b, c)" in md
+    assert next(line for line in md.splitlines() if line.startswith("| 1v1:self")).endswith("| - | | - | |")

@@ -52,6 +52,7 @@ class ExportedPolicy:
     control: ControlConfig = field(default_factory=ControlConfig)
     step_turns: int = 1
     inputs: str = "features"  # mlp input: the continuous features, or "onehot" of the discrete state
+    ties: str = "first"  # equal best values: the first, or one at random (a stochastic policy, e.g. the dodge)
 
     def __post_init__(self) -> None:
         if self.kind not in ("qtable", "mlp"):
@@ -62,6 +63,8 @@ class ExportedPolicy:
             raise ValueError(f"step_turns must be >= 1, got {self.step_turns}")
         if self.inputs not in ("features", "onehot"):
             raise ValueError(f"inputs must be 'features' or 'onehot', got {self.inputs!r}")
+        if self.ties not in ("first", "random"):
+            raise ValueError(f"ties must be 'first' or 'random', got {self.ties!r}")
         if self.kind == "qtable":
             if self.q is None or np.shape(self.q) != (N_STATES, 4) or not np.all(np.isfinite(self.q)):
                 raise ValueError(f"q must be a finite ({N_STATES}, 4) array, got shape {np.shape(self.q)}")
@@ -183,9 +186,14 @@ class ExportedPolicy:
             h = self._activate(self.output_activation if last else self.hidden_activation, w @ h + b)
         return h
 
-    def act(self, obs: Observation) -> int:
-        """Greedy move id (first maximum): 0 forward, 1 backward, 2 clockwise, 3 anticlockwise."""
-        return int(np.argmax(self.values(obs)))
+    def act(self, obs: Observation, rng: np.random.Generator | None = None) -> int:
+        """Greedy move id: 0 forward, 1 backward, 2 clockwise, 3 anticlockwise; the first maximum, or with
+        ``ties="random"`` one of the maxima drawn from ``rng``."""
+        v = self.values(obs)
+        if self.ties == "random":
+            best = np.flatnonzero(v == v.max())
+            return int(best[(rng or np.random.default_rng()).integers(len(best))])
+        return int(np.argmax(v))
 
     def gun_radar(self, obs: Observation) -> tuple[float, float, float]:
         """(gun turn, radar turn, fire power) of the fixed controller (``confront.arena.control.aim``) toward
@@ -226,7 +234,7 @@ class ExportedPolicy:
     # -- file ----------------------------------------------------------------------------------
     def to_text(self) -> str:
         """The policy file read by PolicyModel.java."""
-        lines = ["confront-policy 1", f"kind {self.kind}", f"step_turns {self.step_turns}",
+        lines = ["confront-policy 1", f"kind {self.kind}", f"step_turns {self.step_turns}", f"ties {self.ties}",
                  f"target {self.observation.target}", f"max_distance {float(self.observation.max_distance or 0)!r}",
                  f"include_position {int(self.observation.include_position)}"]
         for f in fields(ControlConfig):

@@ -31,7 +31,7 @@ import numpy as np
 from confront.arena.control import ControlConfig
 from confront.arena.observe import float_mod
 from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
-from confront.engine.export import write_robot
+from confront.engine.export import ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
 from confront.results import BattleResults
 
@@ -259,16 +259,21 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
 
 def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,
                          seed: int = 0, cpu_constant_ms: float = 10.0,
-                         install: EngineInstall | None = None) -> tuple[BattleResults, float]:
+                         install: EngineInstall | None = None, opponent_policy: ExportedPolicy | None = None
+                         ) -> tuple[BattleResults, float]:
     """Play the exported TankBot (a jar, no Python in the loop) for our side of ``scenario`` (``1v1``,
-    ``4v4``, ...) against ``opponents`` in the engine; return (results, our score ratio)."""
+    ``4v4``, ...) against ``opponents`` in the engine, or with ``opponent_policy`` against that paper policy
+    exported as ``confront.PolicyBot`` (e.g. the TD team, the dodge); return (results, our score ratio)."""
     from confront.engine.battle import scenario_battle
     from confront.engine.runner import EngineOptions, run_battle
 
     with tempfile.TemporaryDirectory(prefix="confront-tank-eval-") as tmp:
-        jar = export_tank_robot(policy, Path(tmp) / "tankbot.jar", install)
+        robots = [export_tank_robot(policy, Path(tmp) / "tankbot.jar", install)]
+        if opponent_policy is not None:
+            robots.append(export_robot(opponent_policy, Path(tmp) / "robots", install))
+            opponents = "confront.PolicyBot*"
         spec = scenario_battle(scenario, TANK_ROBOT, opponents, rounds=rounds)
-        res = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms), extra_robots=[jar],
+        res = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms), extra_robots=robots,
                          install=install).results
     ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))
     return res, res.score_ratio(ours.name)

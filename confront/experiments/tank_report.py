@@ -26,7 +26,13 @@ import numpy as np
 
 from confront import checkpoint as ck
 from confront.experiments.spec import config_from_dict, load_toml
-from confront.experiments.tanks import evaluate_tanks, load_tank_model, share_windows
+from confront.experiments.tanks import (
+    PAPER_MOVE_OPPONENTS,
+    evaluate_tanks,
+    load_tank_model,
+    paper_move_robot,
+    share_windows,
+)
 from confront.runs import Run
 
 # the issue's targets per kind of entry: (share, what)
@@ -88,9 +94,11 @@ def _curves(runs: list[Path], out: Path) -> list[Path]:
     return figs
 
 
-def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int) -> float:
+def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int, cfg: Any = None) -> float:
     """The exported robot's score share in one Robocode battle of ``rounds`` rounds (engine ``seed``), kept in
-    ``<run>/eval/engine-<rounds>.json`` as soon as it is played (a long report that dies keeps its battles)."""
+    ``<run>/eval/engine-<rounds>.json`` as soon as it is played (a long report that dies keeps its battles).
+    A paper-move opponent (the TD team, the dodge, random moves) plays as the exported PolicyBot of the run's
+    config ``cfg`` (:func:`confront.experiments.tanks.paper_move_robot`)."""
     from confront.engine.tank_export import evaluate_tank_policy
 
     cache = run / "eval" / f"engine-{rounds}.json"
@@ -98,7 +106,8 @@ def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int) -> 
     key = f"{entry}@{seed}"
     if key not in got:
         scen, _, opp = entry.partition(":")
-        got[key] = evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed)[1]
+        theirs = paper_move_robot(cfg, opp) if opp in PAPER_MOVE_OPPONENTS else None
+        got[key] = evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed, opponent_policy=theirs)[1]
         cache.parent.mkdir(parents=True, exist_ok=True)
         ck.write_atomic(cache, json.dumps(got, indent=1).encode())
     return float(got[key])
@@ -146,8 +155,8 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
         for i, run in enumerate(runs[:engine_runs]):
             pol = policy if i == 0 else load_tank_policy(run)
             for e in entries:
-                if e.partition(":")[2] in BOT_NAMES:
-                    real_runs.setdefault(e, []).append([engine_share(run, pol, e, rounds, k + 1)
+                if e.partition(":")[2] in (*BOT_NAMES, *PAPER_MOVE_OPPONENTS):
+                    real_runs.setdefault(e, []).append([engine_share(run, pol, e, rounds, k + 1, cfgs[i])
                                                         for k in range(engine_seeds)])
         real = {e: v[0] for e, v in real_runs.items()}
     unseen_rows = []
@@ -194,8 +203,10 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
         + (f"; mean and 95% t-interval over {len(runs)} training seeds, then the first run alone." if len(runs) > 1
            else "; one training seed, so no interval over seeds."),
         (f"Engine: the exported `confront.TankBot` jar (no Python) in Robocode 1.9.3.9, {seeds} battles of "
-         f"{rounds} rounds per sample-robot entry (engine seeds 1..{seeds}), the first run's policy; `sim - engine` "
-         "compares that same policy." if seeds else "Engine: not run (pass --engine)."),
+         f"{rounds} rounds per sample-robot and paper-move entry (engine seeds 1..{seeds}; the TD team, the dodge "
+         "and random moves play as the exported `confront.PolicyBot`, random ties drawn with Math.random, which "
+         "the engine's seed does not reach), the first run's policy; `sim - engine` compares that same policy."
+         if seeds else "Engine: not run (pass --engine)."),
         "Target: the issue's engine share for the entry; `met` compares the engine mean with it.",
         "",
     ]

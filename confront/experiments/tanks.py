@@ -30,7 +30,7 @@ import click
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.arena.observe import N_DIST_BINS, N_HEADING_BINS, ObservationConfig
+from confront.arena.observe import N_DIST_BINS, N_HEADING_BINS, N_STATES, ObservationConfig
 from confront.arena.pool import PoolEntry, PoolEnv, PoolStep
 from confront.arena.smdp import SMDPConfig
 from confront.arena.tank import FEATURE_NAMES, OWN_FEATURES, TankSpace
@@ -39,6 +39,7 @@ from confront.learning.ppo import PPO, UPDATE_STATS, PPOConfig, Rollout
 from confront.runs import Run
 
 __all__ = ["TankTrainer", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
+           "PAPER_MOVE_OPPONENTS", "paper_move_values", "paper_move_robot",
            "SnapshotPolicy",
            "save_tank_model", "load_tank_model", "evaluate_tanks"]
 
@@ -76,6 +77,35 @@ def dodge_policy(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) 
     rel = disc // (N_HEADING_BINS * N_DIST_BINS)
     side = (rel == 1) | (rel == 3)
     return np.where(side, rng.integers(0, 2, len(disc)), 2 + rng.integers(0, 2, len(disc)))
+
+
+PAPER_MOVE_OPPONENTS = ("td", "random", "dodge")  # opponents in the paper's moves, playable in the engine
+
+
+def paper_move_values(cfg: ExperimentConfig, opp: str, progress: bool = False) -> np.ndarray:
+    """(320, 4) move values of a paper-move opponent whose maxima are the moves it draws from, uniformly: the TD
+    team's Q table (greedy, random ties), zeros for ``random``, and for ``dodge`` 1 on the two moves of
+    :func:`dodge_policy` in each state."""
+    if opp == "td":
+        return np.asarray(_td_learner(cfg, progress).state_dict()["q"], dtype=np.float64)
+    rel = np.arange(N_STATES) // (N_HEADING_BINS * N_DIST_BINS)
+    q = np.zeros((N_STATES, 4))
+    if opp == "dodge":
+        side = (rel == 1) | (rel == 3)
+        q[side, :2] = 1.0
+        q[~side, 2:] = 1.0
+    elif opp != "random":
+        raise ValueError(f"{opp!r} is not one of the paper-move opponents {PAPER_MOVE_OPPONENTS}")
+    return q
+
+
+def paper_move_robot(cfg: ExperimentConfig, opp: str):  # noqa: ANN201 - an ExportedPolicy (engine import kept lazy)
+    """A paper-move opponent as the exported ``confront.PolicyBot`` plays it in the engine: its move values with
+    random ties, the league's decision interval, the paper's controller and scan memory, as in the simulator."""
+    from confront.engine.export import ExportedPolicy
+
+    return ExportedPolicy("qtable", q=paper_move_values(cfg, opp), observation=ObservationConfig(),
+                          step_turns=cfg.tank.decision_turns, ties="random")
 
 
 def strafe_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
@@ -164,11 +194,16 @@ def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, pro
     return PoolEnv(entries, smdp_tank_config(cfg), seed=seed), snap
 
 
-def _td_opponent(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - returns an OpponentPolicy
-    """The paper's TD team (trained once per seed and cached, as in the paper's experiments), greedy."""
+def _td_learner(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - a TabularQ
+    """The paper's TD team's learner (trained once per seed and cached, as in the paper's experiments)."""
     from confront.experiments.episodes import td_team
 
-    learner, _ = td_team(cfg, 4, progress=progress)
+    return td_team(cfg, 4, progress=progress)[0]
+
+
+def _td_opponent(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - returns an OpponentPolicy
+    """The paper's TD team, greedy (random ties)."""
+    learner = _td_learner(cfg, progress)
 
     def act(disc: np.ndarray, feats: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         return learner.act(disc, rng, explore=False)

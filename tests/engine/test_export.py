@@ -9,7 +9,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from confront.arena.observe import ObservationConfig
+from confront.arena.observe import N_STATES, ObservationConfig
 from confront.engine.battle import BattleSpec
 from confront.engine.bridge import Observation, Scan, format_observation, parse_observation
 from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
@@ -269,3 +269,23 @@ def test_one_robot_kernel_equals_the_batched_state_and_features(cfg: Observation
         assert s1 == s2 and f1.dtype == f2.dtype == np.float32 and np.array_equal(f1, f2), obs
         cases += 1
     assert cases == 600
+
+
+def test_java_random_ties_draw_among_the_maxima(install, tmp_path) -> None:
+    """ties="random": Java picks one of the maxima at random (both halves of the dodge's pairs occur), never
+    another move; "first" stays the first maximum."""
+    rel = np.arange(N_STATES) // 80
+    q = np.zeros((N_STATES, 4))
+    side = (rel == 1) | (rel == 3)
+    q[side, :2], q[~side, 2:] = 1.0, 1.0
+    policy = ExportedPolicy("qtable", q=q, ties="random")
+    lines = _random_observations(20, 7) * 20
+    java = _java_decisions(install, policy, lines, tmp_path)
+    picks: dict[int, set[int]] = {}
+    for line, (a, *_rest, state) in zip(lines, java, strict=True):
+        best = set(np.flatnonzero(q[int(state)] == 1.0).tolist())
+        assert int(a) in best and policy.act(_parse(line), np.random.default_rng(0)) in best
+        picks.setdefault(lines.index(line), set()).add(int(a))
+    assert all(len(p) == 2 for p in picks.values())  # 20 draws each: both maxima (a miss has p = 2^-19)
+    first = _java_decisions(install, ExportedPolicy("qtable", q=q), lines[:20], tmp_path)
+    assert [int(r[0]) for r in first] == [int(np.argmax(q[int(r[4])])) for r in first]

@@ -435,3 +435,21 @@ def test_report_keeps_each_engine_battle(install, tmp_path) -> None:
     assert json.loads(cache.read_text()) == {"1v1:SittingDuck@1": share} and 0.0 <= share <= 1.0
     cache.write_text(json.dumps({"1v1:SittingDuck@1": 0.123}))
     assert engine_share(tmp_path, _policy(7), "1v1:SittingDuck", 1, 1) == 0.123  # read back, not played again
+
+
+@pytest.mark.engine
+def test_tankbot_against_a_paper_move_team_in_the_engine(install) -> None:
+    """A paper-move opponent (here the dodge) plays in the engine as four exported PolicyBots with random ties."""
+    from confront.engine.export import ExportedPolicy
+    from confront.engine.tank_export import evaluate_tank_policy
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.tanks import paper_move_robot
+
+    theirs = paper_move_robot(load_experiment("tanks-demo"), "dodge")
+    assert isinstance(theirs, ExportedPolicy) and theirs.ties == "random" and theirs.step_turns == 5
+    res, share = evaluate_tank_policy(_policy(3), "4v4", "dodge", rounds=2, seed=1, opponent_policy=theirs,
+                                      install=install)
+    names = [c.name for c in res.contestants]
+    assert sorted(n.split()[0] for n in names) == ["confrontteams.Ours4", "confrontteams.Them4"]
+    assert res.rounds == 2 and 0.0 <= share <= 1.0
+    assert sum(c.total for c in res.contestants) > 0

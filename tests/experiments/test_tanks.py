@@ -220,3 +220,20 @@ def test_report_engine_over_runs(tmp_path) -> None:
     assert f"| {m:.3f} [{m - half:.3f}, {m + half:.3f}] | 2/3 |" in row and row.endswith("| 0.90 | yes |")
     assert "| engine, 3 runs | runs met |" in md and "Engine, 3 runs (a, b, c)" in md
     assert next(line for line in md.splitlines() if line.startswith("| 1v1:self")).endswith("| - | | - | |")
+
+
+def test_paper_move_values_have_the_opponents_choices_as_maxima() -> None:
+    """The tables the engine's PolicyBot plays (random ties) draw from the moves the simulator's opponents do."""
+    from confront.arena.observe import N_STATES
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.tanks import dodge_policy, paper_move_values
+
+    cfg = load_experiment("tanks-demo")
+    disc = np.repeat(np.arange(N_STATES), 64)
+    drawn = dodge_policy(disc, np.zeros((len(disc), 1)), np.random.default_rng(0)).reshape(N_STATES, 64)
+    q = paper_move_values(cfg, "dodge")
+    for s in range(N_STATES):
+        assert set(np.flatnonzero(q[s] == q[s].max())) == set(drawn[s].tolist())
+    assert (paper_move_values(cfg, "random") == 0).all()  # every move a maximum: uniform
+    with pytest.raises(ValueError, match="paper-move"):
+        paper_move_values(cfg, "SpinBot")

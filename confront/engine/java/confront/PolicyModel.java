@@ -215,14 +215,20 @@ public final class PolicyModel {
         return values(s, in);
     }
 
-    /** Greedy move (first maximum) for own state and the enemies' last known positions/energies. */
+    /** Greedy move for own state and the enemies' last known positions/energies: the first maximum, or with
+     *  "ties random" one of the maxima at random (Math.random: the engine's seed does not reach it). */
     public int act(double x, double y, double heading, double energy, double[] ex, double[] ey, double[] ee,
                    double width, double height) {
         double[] v = moveValues(x, y, heading, energy, ex, ey, ee, width, height);
         int best = 0;
+        int equal = 1;
+        boolean random = "random".equals(keys.get("ties"));
         for (int i = 1; i < v.length; i++) {
             if (v[i] > v[best]) {
                 best = i;
+                equal = 1;
+            } else if (random && v[i] == v[best] && Math.random() * ++equal < 1.0) {
+                best = i;  // reservoir sampling: each of the equal maxima with probability 1/equal
             }
         }
         return best;

@@ -146,7 +146,7 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str
         for e in entries:
             pc = paired_comparison(np.array(shares[OURS][e]), np.array(shares[m][e]), rng)
             tests[m][e] = {"diff": pc.diff.mean, "lo": pc.diff.lo, "hi": pc.diff.hi, "p": pc.p}
-    result = {"runs": [str(r) for r in runs], "seeds": seeds, "rounds": rounds, "train_rounds": TRAIN_ROUNDS,
+    result = {"runs": [r.name for r in runs], "seeds": seeds, "rounds": rounds, "train_rounds": TRAIN_ROUNDS,
               "entries": entries, "shares": shares, "tests": tests}
     out.mkdir(parents=True, exist_ok=True)
     (out / "compare.json").write_text(json.dumps(result, indent=1))

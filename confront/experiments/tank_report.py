@@ -7,8 +7,9 @@
 Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
 simulator share (``--rounds`` rounds, the mean over runs with a t-interval when there are 2 or more), and with
 ``--engine`` the exported robot's share in Robocode over ``--engine-seeds`` battles of ``--rounds`` rounds
-per sample-robot entry, for the first run or the first ``--engine-runs`` runs (then also the mean of their
-run means with a t-interval, and how many runs reach the target). Engine battles are kept per run
+per sample-robot and paper-move entry (the TD team, the dodge, random moves: exported PolicyBots), for the
+first run or the first ``--engine-runs`` runs (then also the mean of their run means with a t-interval, and
+how many runs reach the target). Engine battles are kept per run
 (``<run>/eval/engine-<rounds>.json``), so runs can be played by separate processes side by side first.
 Writes ``report.md``, ``results.json`` and the learning curves (share against decisions and against wall
 time, per opponent).

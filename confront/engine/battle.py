@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 SAMPLE_ROBOTS: tuple[str, ...] = (
     "SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire",
@@ -171,3 +171,11 @@ def scenario_battle(
     else:
         conts = (_side("Ours", sizes[0], ours_l), _side("Them", sizes[1], opp_l))
     return BattleSpec(conts, rounds=rounds, width=width, height=height, name=scenario)
+
+
+def single_star(spec: BattleSpec, starred: str) -> BattleSpec:
+    """Robots given as loose classes (``confront.PolicyBot*``): a contestant on its own is selected by the starred
+    name, while team files list the plain one (a starred team member plays, but its team-mates are not its
+    team-mates: ``isTeammate`` fails). ``spec`` names the robot plainly; this stars it where it stands alone."""
+    plain = starred.rstrip("*")
+    return replace(spec, contestants=tuple(starred if c == plain else c for c in spec.contestants))

@@ -7,7 +7,7 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from confront.engine.battle import BattleSpec, scenario_battle
+from confront.engine.battle import scenario_battle, single_star
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.runner import EngineOptions, run_battle
@@ -39,20 +39,13 @@ def evaluate_policy(
     opts = EngineOptions(seed=seed, cpu_constant_ms=cpu)
     if mode == "bridge":
         spec = scenario_battle(scenario, BRIDGE_BOT.rstrip("*"), opponents, rounds=rounds)
-        spec = _single_star(spec, BRIDGE_BOT)
+        spec = single_star(spec, BRIDGE_BOT)
         res = run_bridged_battle(spec, policy, opts, every=policy.step_turns, controller=policy.control).run.results
     else:
         with tempfile.TemporaryDirectory(prefix="confront-eval-") as tmp:
             folder = export_robot(policy, Path(tmp) / "robots")
-            spec = _single_star(scenario_battle(scenario, "confront.PolicyBot", opponents, rounds=rounds),
+            spec = single_star(scenario_battle(scenario, "confront.PolicyBot", opponents, rounds=rounds),
                                 "confront.PolicyBot*")
             res = run_battle(spec, opts, extra_robots=[folder]).results
     ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))
     return res, res.score_ratio(ours.name)
-
-
-def _single_star(spec: BattleSpec, starred: str) -> BattleSpec:
-    """A single loose-class robot is selected by its starred name; team files use the plain name."""
-    plain = starred.rstrip("*")
-    conts = tuple(starred if c == plain else c for c in spec.contestants)
-    return BattleSpec(conts, rounds=spec.rounds, width=spec.width, height=spec.height, name=spec.name)

@@ -264,15 +264,15 @@ def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Seq
     """Play the exported TankBot (a jar, no Python in the loop) for our side of ``scenario`` (``1v1``,
     ``4v4``, ...) against ``opponents`` in the engine, or with ``opponent_policy`` against that paper policy
     exported as ``confront.PolicyBot`` (e.g. the TD team, the dodge); return (results, our score ratio)."""
-    from confront.engine.battle import scenario_battle
+    from confront.engine.battle import scenario_battle, single_star
     from confront.engine.runner import EngineOptions, run_battle
 
     with tempfile.TemporaryDirectory(prefix="confront-tank-eval-") as tmp:
         robots = [export_tank_robot(policy, Path(tmp) / "tankbot.jar", install)]
         if opponent_policy is not None:
             robots.append(export_robot(opponent_policy, Path(tmp) / "robots", install))
-            opponents = "confront.PolicyBot*"
-        spec = scenario_battle(scenario, TANK_ROBOT, opponents, rounds=rounds)
+            opponents = "confront.PolicyBot"
+        spec = single_star(scenario_battle(scenario, TANK_ROBOT, opponents, rounds=rounds), "confront.PolicyBot*")
         res = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms), extra_robots=robots,
                          install=install).results
     ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))

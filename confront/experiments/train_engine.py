@@ -33,10 +33,9 @@ from confront.arena.observe import ObservationConfig
 from confront.arena.state import SCORE_PARTS
 from confront.checkpoint import CheckpointError
 from confront.config import ConfigError
-from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle
+from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle, single_star
 from confront.engine.bridge import Action, Observation, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedRun, run_bridged_battle
-from confront.engine.evaluate import _single_star
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.install import find_engine
 from confront.engine.learner_policy import LearnerPolicy
@@ -146,7 +145,7 @@ class _Progress:
 
 def _battle(cfg: ExperimentConfig, opponent: str, rounds: int) -> BattleSpec:
     spec = scenario_battle(cfg.arena.scenario, BRIDGE_BOT.rstrip("*"), opponent, rounds=rounds)
-    return _single_star(_single_star(spec, BRIDGE_BOT), POLICY_BOT)
+    return single_star(single_star(spec, BRIDGE_BOT), POLICY_BOT)
 
 
 class EngineTrainer:

@@ -453,3 +453,59 @@ def test_tankbot_against_a_paper_move_team_in_the_engine(install) -> None:
     assert sorted(n.split()[0] for n in names) == ["confrontteams.Ours4", "confrontteams.Them4"]
     assert res.rounds == 2 and 0.0 <= share <= 1.0
     assert sum(c.total for c in res.contestants) > 0
+
+
+@pytest.mark.engine
+def test_second_team_knows_its_mates_like_the_simulator(install, tmp_path) -> None:
+    """Robocode 1.9.3.9 lists the mates of a team that is not first in the battle under names they do not have
+    (isTeammate fails there); the exported robots also count whoever sent them a message as a mate. A tank team
+    holding one action against a PolicyBot team (a random Q table, second in the battle) then plays the
+    simulator's battle turn by turn (it diverged at turn 6, a PolicyBot locking onto its mate)."""
+    import dataclasses
+
+    from confront.arena.observe import ObservationConfig
+    from confront.arena.scenarios import get_scenario
+    from confront.engine.battle import scenario_battle, single_star
+    from confront.engine.export import ExportedPolicy, export_robot
+    from confront.engine.runner import EngineOptions, run_battle
+
+    sizes = [SPACE.n_features, 8, 8, sum(SPACE.dims)]
+    b2 = np.zeros(sum(SPACE.dims))
+    heads = (4, 4, 2, 0, 0)  # +150 px, at 90 deg to the target, power 2, slot 0, no lead
+    b2[np.cumsum((0,) + SPACE.dims[:-1]) + np.array(heads)] = 10.0
+    ours = TankPolicy(tuple(np.zeros((o, i)) for i, o in zip(sizes, sizes[1:], strict=False)),
+                      (np.zeros(8), np.zeros(8), b2), SPACE, ControlConfig(), 5)
+    q = np.random.default_rng(11).normal(size=(320, 4))
+    theirs = ExportedPolicy("qtable", q=q, observation=ObservationConfig(), step_turns=5)
+    starts = ((100.0, 100.0, 30.0), (100.0, 250.0, 60.0), (100.0, 400.0, 90.0), (100.0, 520.0, 120.0),
+              (700.0, 100.0, 200.0), (700.0, 250.0, 230.0), (700.0, 400.0, 260.0), (700.0, 520.0, 300.0))
+    robots = [export_tank_robot(ours, tmp_path / "tankbot.jar", install), export_robot(theirs, tmp_path / "robots")]
+    spec = single_star(scenario_battle("4v4", "confront.TankBot 1.0", "confront.PolicyBot", rounds=1),
+                       "confront.PolicyBot*")
+    trace = tmp_path / "trace.jsonl"
+    run = run_battle(dataclasses.replace(spec, max_turns=160, initial_positions=starts),
+                     EngineOptions(seed=1, cpu_constant_ms=50.0), trace=trace, extra_robots=robots)
+    assert not run.errors and not sum(run.skipped_turns.values())
+    keys = ("x", "y", "body_heading", "gun_heading", "radar_heading", "energy")
+    turns = [t for t in map(json.loads, trace.read_text().splitlines()) if t.get("type") == "turn"]
+    eng = np.array([[[r[k] for k in keys] for r in t["robots"]] for t in turns])
+
+    env = TeamBattleEnv(get_scenario("4v4").replace(initial_positions=starts, max_turns=100000), 1, seed=1,
+                        opponents="td", config=SMDPConfig(turns_per_step=5, tank=SPACE, reward="score",
+                                                          auto_reset=False), opponent_actions="paper")
+    _, feats = env.reset()
+    disc = env.observe()[1]
+    env.start_recording(0)
+    while env.arena.state.time[0] < len(eng) and not env.arena.state.done[0]:
+        acts = [ours.act(feats[0, i]) if i < 4 else int(np.argmax(q[disc[0, i]])) for i in range(8)]
+        st = env.step(np.array([acts]))
+        feats, disc = st.features, st.discrete
+    replay = env.stop_recording()
+    sim = np.array([r for r, t in zip(replay.robots, replay.turn, strict=True) if t >= 1])[:, :, :6]
+    sim[:, :, 2:5] = np.radians(sim[:, :, 2:5])
+    n = min(len(sim), len(eng))
+    assert n >= 150
+    d = np.abs(eng[:n] - sim[:n])
+    d[..., 2:5] = np.abs((eng[:n, :, 2:5] - sim[:n, :, 2:5] + math.pi) % (2 * math.pi) - math.pi)
+    bad = np.flatnonzero(d.max(axis=(1, 2)) > 1e-6)
+    assert bad.size == 0, f"turn {bad[0] + 1}: engine {eng[bad[0]]}, simulator {sim[bad[0]]}"

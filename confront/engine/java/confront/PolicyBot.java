@@ -6,9 +6,12 @@ import java.io.InputStreamReader;
 import java.io.Reader;
 import java.io.StringReader;
 import java.nio.charset.StandardCharsets;
+import java.util.HashSet;
 import java.util.LinkedHashMap;
 import java.util.Map;
+import java.util.Set;
 
+import robocode.MessageEvent;
 import robocode.RobotDeathEvent;
 import robocode.ScannedRobotEvent;
 import robocode.TeamRobot;
@@ -20,6 +23,10 @@ import robocode.TeamRobot;
  */
 public class PolicyBot extends TeamRobot {
     private final Map<String, double[]> enemies = new LinkedHashMap<>();
+    /** Names that sent us a message: team-mates. Robocode 1.9.3.9's own list misses the mates of a team that is
+     *  not first in the battle (its members carry a per-class count, the robots their battle index), so every
+     *  PolicyBot announces itself in its first turn. */
+    private final Set<String> heard = new HashSet<>();
 
     @Override
     public void run() {
@@ -38,6 +45,13 @@ public class PolicyBot extends TeamRobot {
             }
         }
         int step = model.stepTurns();
+        if (getTeammates() != null) {
+            try {
+                broadcastMessage(Boolean.TRUE);
+            } catch (IOException e) {
+                out.println("CONFRONT policy-error broadcast " + e);
+            }
+        }
         while (true) {
             double[][] e = known();
             long turn = getTime() + 1;  // the commands set now take effect in this turn
@@ -92,12 +106,20 @@ public class PolicyBot extends TeamRobot {
 
     @Override
     public void onScannedRobot(ScannedRobotEvent e) {
-        if (isTeammate(e.getName())) {
+        if (isTeammate(e.getName()) || heard.contains(e.getName())) {
             return;
         }
         double abs = getHeadingRadians() + e.getBearingRadians();
         enemies.put(e.getName(), new double[] {getX() + e.getDistance() * Math.sin(abs),
                 getY() + e.getDistance() * Math.cos(abs), e.getEnergy()});
+    }
+
+    @Override
+    public void onMessageReceived(MessageEvent e) {
+        if (e.getSender() != null) {
+            heard.add(e.getSender());
+            enemies.remove(e.getSender());  // scanned before its message arrived
+        }
     }
 
     @Override

@@ -36,6 +36,7 @@ public class TankBot extends TeamRobot {
     /** name: {x, y, energy} of the latest message this round. */
     private final Map<String, double[]> mates = new LinkedHashMap<>();
     private final Set<String> deadMates = new HashSet<>();
+    private final Set<String> heard = new HashSet<>();  // names that sent us a message: team-mates
     private int decisions;
     private int shots;
 
@@ -152,9 +153,16 @@ public class TankBot extends TeamRobot {
         }
     }
 
+    /** A team-mate: by the engine's list, or by having sent us a message (only team-mates can). Robocode 1.9.3.9
+     *  names the list's members with a per-class count, the robots themselves with their battle index, so the
+     *  list misses the mates of a team that is not first in the battle (Battle.createPeers). */
+    private boolean mate(String name) {
+        return isTeammate(name) || heard.contains(name);
+    }
+
     private void remember(ScannedRobotEvent e) {
         String name = e.getName();
-        if (isTeammate(name)) {
+        if (mate(name)) {
             return;
         }
         double abs = getHeadingRadians() + e.getBearingRadians();
@@ -170,8 +178,12 @@ public class TankBot extends TeamRobot {
     public void onMessageReceived(MessageEvent e) {
         String from = e.getSender();
         Object m = e.getMessage();
-        if (from != null && isTeammate(from) && !deadMates.contains(from) && m instanceof double[]
-                && ((double[]) m).length == 3) {
+        if (from == null) {
+            return;
+        }
+        heard.add(from);
+        enemies.remove(from);  // scanned before its first message arrived
+        if (!deadMates.contains(from) && m instanceof double[] && ((double[]) m).length == 3) {
             mates.put(from, ((double[]) m).clone());
         }
     }
@@ -180,7 +192,7 @@ public class TankBot extends TeamRobot {
     public void onRobotDeath(RobotDeathEvent e) {
         String name = e.getName();
         enemies.remove(name);
-        if (isTeammate(name)) {
+        if (mate(name)) {
             mates.remove(name);
             deadMates.add(name);
         }

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -103,6 +104,8 @@ def run_sweep(grid: str | Path, out: str | Path, address: str | None = None, see
     click.echo(f"sweep: {len(trials)} trials, {len(trials) - len(todo)} already done, {len(todo)} to run")
     if todo:
         if not ray.is_initialized():
+            # a local cluster on a busy machine can take more than Ray's 60 s to register its raylet
+            os.environ.setdefault("RAY_raylet_start_wait_time_s", "300")
             ray.init(address=address, num_cpus=num_cpus if address is None else None,
                      include_dashboard=False, log_to_driver=False)
         # one CPU a trial: its simulator and torch run one thread (CONFRONT_THREADS), so trials do not oversubscribe

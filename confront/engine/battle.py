@@ -175,7 +175,7 @@ def scenario_battle(
 
 def single_star(spec: BattleSpec, starred: str) -> BattleSpec:
     """Robots given as loose classes (``confront.PolicyBot*``): a contestant on its own is selected by the starred
-    name, while team files list the plain one (a starred team member plays, but its team-mates are not its
-    team-mates: ``isTeammate`` fails). ``spec`` names the robot plainly; this stars it where it stands alone."""
+    name, while team files list the plain one. ``spec`` names the robot plainly; this stars it where it stands
+    alone (the rest of ``spec`` is kept)."""
     plain = starred.rstrip("*")
     return replace(spec, contestants=tuple(starred if c == plain else c for c in spec.contestants))

@@ -195,17 +195,18 @@ def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, prog
     tc = cfg.train
     total, every, window = tc.rounds, tc.checkpoint_every, min(tc.session_rounds, 200)
     start = time.time()
-    next_ckpt = [(trainer.rounds_done // every + 1) * every]
+    next_ckpt = (trainer.rounds_done // every + 1) * every
     writer = SummaryWriter(str(run.path / "tb"))
 
     def on_step(scalars: dict[str, float]) -> None:
+        nonlocal next_ckpt
         _log(writer, trainer, scalars, window)
-        if next_ckpt[0] <= trainer.rounds_done < total:
+        if next_ckpt <= trainer.rounds_done < total:
             arrays, meta = trainer.state()
             meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start)
             ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
             run.write_table("rounds", trainer.rows)
-            next_ckpt[0] = (trainer.rounds_done // every + 1) * every
+            next_ckpt = (trainer.rounds_done // every + 1) * every
 
     try:
         run_rounds(trainer, total, progress, on_step=on_step, window=window)

@@ -2,8 +2,9 @@
 
 import numpy as np
 import pytest
+import torch
 
-from confront.learning.ppo import PPO, PPOConfig, Rollout, gae, greedy_joint, team_mean
+from confront.learning.ppo import PPO, PPOConfig, Rollout, Tanh, gae, greedy_joint, team_mean
 
 
 def test_gae_hand_computed() -> None:
@@ -94,6 +95,29 @@ def test_bad_state_and_config_refused() -> None:
         a.load_state_dict(PPO(3, (2, 3), PPOConfig(hidden=8)).state_dict())
     with pytest.raises(ValueError, match="ppo.rollout_steps"):
         PPOConfig(rollout_steps=0)
+    with pytest.raises(ValueError, match="ppo.threads"):
+        PPOConfig(threads=0)
+
+
+def test_tanh_is_tanh_with_tanhs_gradient() -> None:
+    x = torch.linspace(-12, 12, 2001, dtype=torch.float32, requires_grad=True)
+    y = Tanh()(x)
+    np.testing.assert_allclose(y.detach().numpy(), np.tanh(x.detach().numpy().astype(np.float64)), atol=2.5e-7)
+    assert Tanh()(torch.tensor([0.0, -12.0, 12.0])).tolist() == [0.0, -1.0, 1.0]  # odd at 0; saturates
+    y.sum().backward()
+    np.testing.assert_allclose(x.grad.numpy(), 1 - np.tanh(x.detach().numpy().astype(np.float64)) ** 2, atol=1e-6)
+    x64 = torch.randn(20, dtype=torch.float64, requires_grad=True)
+    assert torch.autograd.gradcheck(Tanh(), (x64,))
+
+
+def test_update_widens_to_its_threads_and_acts_on_one() -> None:
+    seen: list[int] = []
+    ppo = PPO(2, (2, 3), PPOConfig(hidden=8, team_critic=False, threads=2), seed=0)
+    learn = ppo._learn
+    ppo._learn = lambda ro: (seen.append(torch.get_num_threads()), learn(ro))[1]  # type: ignore[method-assign]
+    assert torch.get_num_threads() == 1
+    ppo.update(_bandit_rollout(ppo, np.random.default_rng(0)))
+    assert seen == [2] and torch.get_num_threads() == 1
 
 
 def test_overlap_acts_one_update_behind_and_stays_deterministic() -> None:

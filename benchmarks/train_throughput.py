@@ -13,13 +13,15 @@ from confront.experiments.spec import load_experiment
 from confront.experiments.tanks import TankTrainer
 
 
-def measure(opponents: list[str], battles: int, updates: int, config: str = "tanks", overlap: bool = True
+def measure(opponents: list[str] | None, battles: int, updates: int, config: str = "tanks", overlap: bool = True
             ) -> dict[str, float | int | str]:
     """Run ``updates`` PPO updates after two warm-up ones (kernels compile; the first has no update before it);
-    figures over the timed ones."""
-    ov = [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", "league.focus=[]",
-          f"ppo.overlap={str(overlap).lower()}"]
-    trainer = TankTrainer(load_experiment(config, ov))
+    figures over the timed ones. ``opponents`` None: the config's own league (battles, focus) as it trains."""
+    ov = [f"ppo.overlap={str(overlap).lower()}"]
+    if opponents is not None:
+        ov += [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", "league.focus=[]"]
+    cfg = load_experiment(config, ov)
+    trainer = TankTrainer(cfg)
     trainer.update()  # warm-up: numba kernels, torch
     trainer.update()
     d0, t0, c0 = trainer.decisions, time.perf_counter(), time.process_time()
@@ -30,7 +32,8 @@ def measure(opponents: list[str], battles: int, updates: int, config: str = "tan
         upd += row["update_wait_fraction"]
     wall = time.perf_counter() - t0
     n = trainer.decisions - d0
-    return {"config": config, "overlap": overlap, "league": ",".join(opponents), "agents": trainer.pool.n_agents,
+    league = ",".join(opponents) if opponents is not None else f"its own ({len(cfg.league.opponents)} entries)"
+    return {"config": config, "overlap": overlap, "league": league, "agents": trainer.pool.n_agents,
             "decisions": n,
             "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
             "env_fraction": env / updates, "update_wait_fraction": upd / updates, "wall_s": wall}
@@ -43,12 +46,12 @@ def main() -> None:
     args = ap.parse_args()
     league = ["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"]
     teams = ["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"]
-    demo = ["1v1:dodge", "4v4:dodge", "4v4:td", "1v1:SpinBot", "1v1:Walls"]
     rows = []
-    for overlap in (True, False):  # the update beside the next rollout (the default), or after it
-        rows += [measure(league, args.battles * 2, args.updates, overlap=overlap),
-                 measure(teams, args.battles, args.updates, overlap=overlap),
-                 measure(demo, 24, args.updates, "tanks-demo", overlap=overlap)]
+    for overlap in (False, True):  # collect, then update (the default); or the update beside the next rollout
+        rows += [measure(None, 0, args.updates, overlap=overlap),
+                 measure(None, 0, args.updates, "tanks-demo", overlap=overlap),
+                 measure(league, args.battles * 2, args.updates, overlap=overlap),
+                 measure(teams, args.battles, args.updates, overlap=overlap)]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     print("| config | overlap | league | agents | decisions/s | decisions/CPU-s | env | update (or waiting for it) |")
     print("|---|---|---|---:|---:|---:|---:|---:|")

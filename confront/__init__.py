@@ -4,9 +4,15 @@
 ``confront.parallel_env(scenario="4v4", opponents=...)`` for a team (PettingZoo).
 """
 
+import os as _os
 from typing import Any
 
-import gymnasium as _gym
+# OpenMP workers (torch's update threads) sleep as soon as they wait instead of spinning, unless the user set a
+# policy: on a machine whose cores are taken, spinning workers made PPO training 2.2x slower (docs/learning.md).
+# It must be set before torch loads its OpenMP runtime, hence here, first.
+_os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import gymnasium as _gym  # noqa: E402
 
 __version__ = "0.1.0"
 

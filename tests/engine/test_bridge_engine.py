@@ -151,7 +151,11 @@ def test_history_brings_every_turn_between_decisions(install, lead: int) -> None
     res = run_bridged_battle(BattleSpec((BRIDGE_BOT, "SpinBot"), rounds=2), Recording(), opts, every=5,
                              controller=policy.control, history=True, lead=lead)
     assert res.ok, (res.failures, res.server_errors)
-    assert [r for r, _ in ends] == [0, 1] and all(n >= 1 for _, n in ends)
+    # what to read when a round's end line goes missing (seen twice under load; cause not yet caught)
+    why = (f"ends {ends}; skipped {res.run.skipped_turns}; round turns {res.run.round_turns}; errors "
+           f"{res.run.errors}; decisions {res.decisions}; connections {res.connections}; reports "
+           f"{res.run.summary.get('robot_reports')}")
+    assert [r for r, _ in ends] == [0, 1] and all(n >= 1 for _, n in ends), why
     assert res.run.skipped_turns or all(sent)
     for hs in records.values():
         times = [h.time for h in hs]

@@ -191,3 +191,17 @@ def test_learning_rate_anneals_linearly_to_zero() -> None:
     ppo.update(_bandit_rollout(ppo, np.random.default_rng(0)))
     for k, v in before.items():  # a zero step leaves the weights
         np.testing.assert_array_equal(v, ppo.state_dict()[k], err_msg=k)
+
+
+@pytest.mark.parametrize(("given", "want"), [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
+def test_openmp_workers_sleep_unless_the_user_says_otherwise(given: str | None, want: str) -> None:
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    out = subprocess.run([sys.executable, "-c", "import confront, os; print(os.environ['OMP_WAIT_POLICY'])"],
+                         env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == want

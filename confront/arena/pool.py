@@ -151,25 +151,9 @@ class PoolEnv:
                         rounds)
 
     def _step_together(self, full_actions: list[np.ndarray]) -> list[StepResult]:
-        """Every env's step (what ``env.step`` does) with all the kernels run together, largest first. With enough
-        entries to keep the threads busy each entry is one task (begin, kernel, finish) on whichever thread is
-        free, so one thread's Python bookkeeping overlaps another's GIL-free kernel; entries share no state, so
-        the results do not depend on the schedule."""
-        workers = _pool()._max_workers
-        order = sorted(range(len(self.envs)), key=lambda k: -self.envs[k].n_battles * self.envs[k].n_robots)
-        if len(self.envs) >= 2 * workers and all(env._callees_compiled for env in self.envs):
-            out: list[StepResult | None] = [None] * len(self.envs)
-
-            def task(k: int) -> None:
-                env = self.envs[k]
-                rewards, active, obs = env._begin(full_actions[k])
-                (call,) = env._kernel_calls(0, env.turns_per_step, rewards, obs, whole=True)
-                _smdp_turns(*call)
-                out[k] = env._finish(rewards, active, obs)
-
-            run_parallel(_pool(), task, [(k,) for k in order], workers)
-            return out  # type: ignore[return-value]
+        """Every env's step (what ``env.step`` does) with all the kernels run together, largest first."""
         begun = [env._begin(full) for env, full in zip(self.envs, full_actions, strict=True)]
+        workers = _pool()._max_workers
         whole = len(self.envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
         calls = []
         for k, (env, (rewards, _, obs)) in enumerate(zip(self.envs, begun, strict=True)):

@@ -7,10 +7,11 @@
 import os as _os
 from typing import Any
 
-# OpenMP workers (torch's update threads) sleep as soon as they wait instead of spinning, unless the user set a
-# policy: on a machine whose cores are taken, spinning workers made PPO training 2.2x slower (docs/learning.md).
-# It must be set before torch loads its OpenMP runtime, hence here, first.
-_os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# torch's OpenMP workers (the PPO update's second thread, libgomp) spin 3000 times, a few microseconds, before
+# they sleep, unless the user chose a wait policy: libgomp's default spins ~300k times, and beside busy cores that
+# made training 4-6x slower; never spinning cost ~25% on an idle machine (docs/learning.md). Set before torch loads.
+if "OMP_WAIT_POLICY" not in _os.environ:
+    _os.environ.setdefault("GOMP_SPINCOUNT", "3000")
 
 import gymnasium as _gym  # noqa: E402
 

@@ -193,15 +193,14 @@ def test_learning_rate_anneals_linearly_to_zero() -> None:
         np.testing.assert_array_equal(v, ppo.state_dict()[k], err_msg=k)
 
 
-@pytest.mark.parametrize(("given", "want"), [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
-def test_openmp_workers_sleep_unless_the_user_says_otherwise(given: str | None, want: str) -> None:
+@pytest.mark.parametrize(("given", "want"), [({}, "3000"), ({"OMP_WAIT_POLICY": "ACTIVE"}, "unset"),
+                                           ({"GOMP_SPINCOUNT": "10"}, "10")])
+def test_openmp_workers_spin_briefly_unless_the_user_says_otherwise(given: dict[str, str], want: str) -> None:
     import os
     import subprocess
     import sys
 
-    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
-    if given is not None:
-        env["OMP_WAIT_POLICY"] = given
-    out = subprocess.run([sys.executable, "-c", "import confront, os; print(os.environ['OMP_WAIT_POLICY'])"],
-                         env=env, capture_output=True, text=True, check=True)
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")} | given
+    code = "import confront, os; print(os.environ.get('GOMP_SPINCOUNT', 'unset'))"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == want

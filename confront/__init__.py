@@ -9,7 +9,7 @@ from typing import Any
 
 # torch's OpenMP workers (the PPO update's second thread, libgomp) spin 3000 times, a few microseconds, before
 # they sleep, unless the user chose a wait policy: libgomp's default spins ~300k times, and beside busy cores that
-# made training 4-6x slower; never spinning cost ~25% on an idle machine (docs/learning.md). Set before torch loads.
+# made training 4-6x slower; never spinning cost ~30% on an idle machine (docs/learning.md). Set before torch loads.
 if "OMP_WAIT_POLICY" not in _os.environ:
     _os.environ.setdefault("GOMP_SPINCOUNT", "3000")
 

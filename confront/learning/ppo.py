@@ -63,7 +63,7 @@ class PPOConfig:
     max_grad_norm: float = 0.5
     reward_scale: float = 0.01  # score points -> reward units
     team_critic: bool = True
-    threads: int = 1  # torch threads of the update (acting uses one); with ``overlap`` of both (beside the env)
+    threads: int = 2  # torch threads of the update (acting uses one); with ``overlap`` of both (beside the env)
     overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
     ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
     anneal_lr: bool = False  # the Adam step falls linearly from lr to 0 over the run (CleanRL's anneal_lr)

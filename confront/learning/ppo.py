@@ -30,6 +30,7 @@ so a checkpoint resumes exactly.
 from __future__ import annotations
 
 import copy
+import warnings
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -67,6 +68,8 @@ class PPOConfig:
     overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
     ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
     anneal_lr: bool = False  # the Adam step falls linearly from lr to 0 over the run (CleanRL's anneal_lr)
+    precision: str = "fp32"  # the update's hidden layers: "fp32", or "bf16" (autocast: bfloat16 products, float32
+    # sums, weights and output layers; 1.6x faster where the CPU has bfloat16 instructions)
 
     def __post_init__(self) -> None:
         if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:
@@ -81,6 +84,8 @@ class PPOConfig:
             v = getattr(self, name)
             if not lo <= v <= hi:
                 raise ValueError(f"ppo.{name} must be in [{lo}, {hi}], got {v!r}")
+        if self.precision not in ("fp32", "bf16"):
+            raise ValueError(f"ppo.precision must be fp32 or bf16, got {self.precision!r}")
         for name in ("lr", "reward_scale", "max_grad_norm"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"ppo.{name} must be > 0, got {getattr(self, name)!r}")
@@ -158,14 +163,31 @@ class ActorCritic(nn.Module):
         self.register_buffer("pad", torch.from_numpy(np.arange(width)[None, :] >= np.array(self.dims)[:, None]),
                              persistent=False)
 
-    def log_probs(self, obs: torch.Tensor) -> torch.Tensor:
+    def log_probs(self, obs: torch.Tensor, bf16: bool = False) -> torch.Tensor:
         """Per-head log-probabilities (N, H, max d), -inf beyond a head's d choices."""
-        z = self.actor(obs)[:, self.pad_index].view(len(obs), *self.pad.shape)
+        z = _mlp(self.actor, obs, bf16).index_select(1, self.pad_index).view(len(obs), *self.pad.shape)
         return torch.log_softmax(z.masked_fill(self.pad, -torch.inf), dim=-1)
 
-    def value(self, critic_in: torch.Tensor) -> torch.Tensor:
+    def value(self, critic_in: torch.Tensor, bf16: bool = False) -> torch.Tensor:
         """V (N,)."""
-        return self.critic(critic_in).squeeze(-1)
+        return _mlp(self.critic, critic_in, bf16).squeeze(-1)
+
+
+def _bf16_fast() -> bool:
+    """Whether this CPU multiplies bfloat16 natively (oneDNN's check)."""
+    try:
+        return bool(torch.ops.mkldnn._is_mkldnn_bf16_supported())
+    except (AttributeError, RuntimeError):
+        return False
+
+
+def _mlp(seq: nn.Sequential, x: torch.Tensor, bf16: bool) -> torch.Tensor:
+    """``seq(x)``; with ``bf16`` the hidden layers under bfloat16 autocast and the output layer in float32."""
+    if not bf16:
+        return seq(x)
+    with torch.autocast("cpu", dtype=torch.bfloat16):
+        h = seq[:-1](x)
+    return seq[-1](h.float())
 
 
 def team_mean(obs: np.ndarray, group: np.ndarray, n_groups: int, alive: np.ndarray) -> np.ndarray:
@@ -230,6 +252,9 @@ class PPO:
         # acting runs between simulator steps on one thread; the update of the sequential schedule has the cores
         # to itself (:meth:`_learn` widens to ``threads``); with ``overlap`` both run beside the env at ``threads``
         self._act_threads = self.config.threads if self.config.overlap else 1
+        if self.config.precision == "bf16" and not _bf16_fast():
+            warnings.warn("ppo.precision = bf16 on a CPU without bfloat16 instructions (AVX512-BF16, AMX): the "
+                          "update runs, emulated and slower than fp32", stacklevel=2)
         torch.set_num_threads(self._act_threads)
         torch.manual_seed(seed)
         self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic)
@@ -343,29 +368,32 @@ class PPO:
                 prox_logp = self.net.log_probs(obs).gather(2, heads[:, :, None]).sum(dim=(1, 2))
             weight = (prox_logp - old_logp).exp().clamp(max=IS_MAX)  # behaviour -> proximal, truncated
         size = max(1, n // c.minibatches)
+        bf16 = c.precision == "bf16"
         count = 0
         ent_coef = entropy_coef(c, self.updates)
         for _ in range(c.epochs):
             perm = torch.randperm(n, generator=self.gen)
             for start in range(0, n, size):
                 idx = perm[start:start + size]
-                lp = self.net.log_probs(obs[idx])
-                logp = lp.gather(2, heads[idx][:, :, None]).sum(dim=(1, 2))
+                # index_select: 4-8x faster than advanced indexing here (same values)
+                mb_obs, mb_heads, mb_crit, mb_prox, a, mb_w, mb_old_v, mb_ret = (
+                    t.index_select(0, idx) for t in (obs, heads, crit, prox_logp, adv_t, weight, old_v, ret_t))
+                lp = self.net.log_probs(mb_obs, bf16)
+                logp = lp.gather(2, mb_heads[:, :, None]).sum(dim=(1, 2))
                 entropy = -(lp.exp() * lp.masked_fill(self.net.pad, 0.0)).sum(dim=(1, 2)).mean()
-                ratio = (logp - prox_logp[idx]).exp()
-                a = adv_t[idx]
+                ratio = (logp - mb_prox).exp()
                 a = (a - a.mean()) / (a.std() + 1e-8) if len(idx) > 1 else a
-                pg = (weight[idx] * torch.max(-a * ratio, -a * ratio.clamp(1 - c.clip, 1 + c.clip))).mean()
-                v = self.net.value(crit[idx])
-                v_clip = old_v[idx] + (v - old_v[idx]).clamp(-c.clip, c.clip)
-                vl = 0.5 * torch.max((v - ret_t[idx]) ** 2, (v_clip - ret_t[idx]) ** 2).mean()
+                pg = (mb_w * torch.max(-a * ratio, -a * ratio.clamp(1 - c.clip, 1 + c.clip))).mean()
+                v = self.net.value(mb_crit, bf16)
+                v_clip = mb_old_v + (v - mb_old_v).clamp(-c.clip, c.clip)
+                vl = 0.5 * torch.max((v - mb_ret) ** 2, (v_clip - mb_ret) ** 2).mean()
                 loss = pg - ent_coef * entropy + c.vf_coef * vl
                 self.opt.zero_grad()
                 loss.backward()
                 nn.utils.clip_grad_norm_(self.net.parameters(), c.max_grad_norm)
                 self.opt.step()
                 with torch.no_grad():
-                    lr = logp - prox_logp[idx]
+                    lr = logp - mb_prox
                     stats["approx_kl"] += float(((lr.exp() - 1) - lr).mean())
                     stats["clip_frac"] += float(((ratio - 1).abs() > c.clip).float().mean())
                 stats["policy_loss"] += float(pg.detach())

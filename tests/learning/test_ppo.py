@@ -97,6 +97,30 @@ def test_bad_state_and_config_refused() -> None:
         PPOConfig(rollout_steps=0)
     with pytest.raises(ValueError, match="ppo.threads"):
         PPOConfig(threads=0)
+    with pytest.raises(ValueError, match="ppo.precision must be fp32 or bf16"):
+        PPOConfig(precision="fp16")
+
+
+def test_bf16_update_learns_and_stays_near_fp32() -> None:
+    """bfloat16 hidden layers: log-probabilities within bf16's rounding of fp32's, output layers float32, one
+    update's step within a few percent of fp32's, and the bandit still learned."""
+    ppo = PPO(2, (2, 3), PPOConfig(hidden=16, lr=3e-3, team_critic=False, ent_coef=0.0, precision="bf16"), seed=0)
+    obs = torch.from_numpy(np.random.default_rng(2).standard_normal((64, 2)).astype(np.float32))
+    lp32, lp16 = ppo.net.log_probs(obs), ppo.net.log_probs(obs, bf16=True)
+    assert lp16.dtype == torch.float32 and ppo.net.value(obs, bf16=True).dtype == torch.float32
+    fin = torch.isfinite(lp32)
+    assert 0 < (lp16[fin] - lp32[fin]).abs().max() < 0.02  # not fp32's bits, within bf16's 2^-8
+    twin = PPO(2, (2, 3), PPOConfig(hidden=16, lr=3e-3, team_critic=False, ent_coef=0.0), seed=0)
+    ro = _bandit_rollout(twin, np.random.default_rng(0))
+    w0 = twin.net.actor[0].weight.detach().clone()
+    twin.update(ro)
+    ppo.update(ro)
+    step32, step16 = twin.net.actor[0].weight.detach() - w0, ppo.net.actor[0].weight.detach() - w0
+    assert 0 < (step16 - step32).norm() < 0.05 * step32.norm()
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        ppo.update(_bandit_rollout(ppo, rng))
+    assert _bandit_rollout(ppo, rng).reward.mean() > 0.95
 
 
 def test_tanh_is_tanh_with_tanhs_gradient() -> None:

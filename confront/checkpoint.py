@@ -12,6 +12,10 @@ An edited ``meta.json`` (say ``rounds_done``) fails its checksum and is refused;
 fit the checkpoint's name or its rows is refused too (also for version-1 checkpoints, which had no metadata
 checksum). Saving removes only checkpoints older than the one saved; without ``LATEST`` the newest checkpoint
 that verifies is used, and that is said on stderr.
+
+Tables in the metadata (a list of flat rows with one key order and one type per column, such as a run's round
+rows) are stored as columns in ``state.npz`` (``table.<key>.<i>``, their names in meta's ``tables``): saving a
+60000-row table then takes milliseconds instead of seconds of JSON; :func:`load` gives the rows back as they were.
 """
 
 from __future__ import annotations
@@ -31,8 +35,9 @@ from typing import Any
 import numpy as np
 
 FORMAT = "confront-checkpoint"
-FORMAT_VERSION = 2  # 2: meta.json carries meta_sha256; version 1 (without it) is still read
-READ_VERSIONS = (1, 2)
+FORMAT_VERSION = 3  # 3: tables as npz columns; 2: meta.json carries meta_sha256; 1 (without it) is still read
+READ_VERSIONS = (1, 2, 3)
+TABLE = "table."  # npz key prefix of a metadata table's columns
 NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}")
 ROUND_NAME = re.compile(r"round-(\d+)")
 
@@ -94,6 +99,30 @@ def write_atomic(path: Path, data: bytes) -> None:
         raise
 
 
+def _as_columns(rows: Any) -> list[tuple[str, np.ndarray]] | None:
+    """A list of flat rows with one key order and one scalar type (bool, int, float, str) per column as (name,
+    array) columns; None if ``rows`` is not such a table."""
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        return None
+    keys = list(rows[0])
+    if any(list(r) != keys for r in rows):
+        return None
+    out = []
+    for k in keys:
+        values = [r[k] for r in rows]
+        kind = {type(v) for v in values}
+        if len(kind) != 1 or not kind <= {bool, int, float, str}:
+            return None
+        t = kind.pop()
+        if t is str and any(v.endswith("\0") for v in values):  # numpy's strings drop trailing NULs
+            return None
+        try:
+            out.append((k, np.array(values, dtype={bool: np.bool_, int: np.int64, float: np.float64, str: np.str_}[t])))
+        except OverflowError:
+            return None
+    return out
+
+
 def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], meta: Mapping[str, Any],
          keep: int = 2) -> Path:
     """Save a checkpoint ``directory/name`` atomically, point ``LATEST`` at it and keep the newest ``keep``.
@@ -104,11 +133,23 @@ def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], met
         raise ValueError(f"checkpoint name {name!r} must be letters, digits, '.', '_' or '-'")
     root = Path(directory)
     root.mkdir(parents=True, exist_ok=True)
+    if any(k.startswith(TABLE) for k in arrays):
+        raise ValueError(f"array names starting with {TABLE!r} are reserved for tables")
+    arrays = {k: np.asarray(v) for k, v in arrays.items()}
+    meta = dict(meta)
+    tables: dict[str, list[str]] = {}
+    for key, value in list(meta.items()):
+        if (cols := _as_columns(value)) is not None:
+            tables[key] = [c for c, _ in cols]
+            arrays.update({f"{TABLE}{key}.{i}": a for i, (_, a) in enumerate(cols)})
+            del meta[key]
+    if tables:
+        meta["tables"] = tables
     tmp = Path(tempfile.mkdtemp(dir=root, prefix=f".{name}."))
     try:
         npz = tmp / "state.npz"
         with npz.open("wb") as fh:
-            np.savez(fh, **{k: np.asarray(v) for k, v in arrays.items()})
+            np.savez(fh, **arrays)
             fh.flush()
             os.fsync(fh.fileno())
         full_meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "sha256": _sha256(npz), **meta}
@@ -199,7 +240,6 @@ def load(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         )
     if version >= 2 and meta.get("meta_sha256") != _meta_digest(meta):
         raise CheckpointError(f"checkpoint {p} has an edited or corrupt meta.json: it does not match its checksum")
-    _check_counters(p, meta)
     try:
         if _sha256(npz_path) != meta.get("sha256"):
             raise CheckpointError(
@@ -208,4 +248,11 @@ def load(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
         raise CheckpointError(f"checkpoint {p} cannot be read: {str(exc)[:200]}") from None
+    try:
+        for key, names in meta.pop("tables", {}).items():
+            cols = [arrays.pop(f"{TABLE}{key}.{i}").tolist() for i in range(len(names))]
+            meta[key] = [dict(zip(names, vals, strict=True)) for vals in zip(*cols, strict=True)]
+    except (KeyError, ValueError, AttributeError, TypeError) as exc:
+        raise CheckpointError(f"checkpoint {p} has a table that does not fit its columns ({exc})") from None
+    _check_counters(p, meta)
     return arrays, meta

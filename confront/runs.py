@@ -15,6 +15,7 @@ import csv
 import io
 import json
 import math
+import os
 import shutil
 import time
 from collections.abc import Mapping, Sequence
@@ -52,6 +53,16 @@ def _clean(v: Any) -> Any:
     if isinstance(v, float) and not math.isfinite(v):
         return None
     return v
+
+
+def _csv(rows: Sequence[Mapping[str, Any]], columns: list[str], header: bool) -> bytes:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+    if header:
+        writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _clean(row.get(k)) for k in columns})
+    return buf.getvalue().encode()
 
 
 @dataclass(frozen=True)
@@ -105,13 +116,8 @@ class Run:
         columns: list[str] = []
         for row in rows:
             columns.extend(k for k in row if k not in columns)
-        buf = io.StringIO()
-        writer = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: _clean(row.get(k)) for k in columns})
         written = [out / f"{name}.csv"]
-        write_atomic(written[0], buf.getvalue().encode())
+        write_atomic(written[0], _csv(rows, columns, header=True))
         if pa is not None and rows:
             table = pa.table({c: [_clean(r.get(c)) for r in rows] for c in columns})
             sink = pa.BufferOutputStream()
@@ -119,6 +125,29 @@ class Run:
             written.append(out / f"{name}.parquet")
             write_atomic(written[1], sink.getvalue().to_pybytes())
         return written
+
+    def append_table(self, name: str, rows: Sequence[Mapping[str, Any]], written: int) -> int:
+        """Bring ``metrics/<name>.csv``, which holds the first ``written`` of ``rows``, up to all of them by
+        appending the rest (CSV only; :meth:`write_table` writes the whole table, and the Parquet file). With
+        ``written`` 0, or new rows whose columns are not the file's, the CSV is rewritten whole (atomically).
+        Returns ``len(rows)``. What a run's checkpoints call: the cost grows with the new rows, not the run."""
+        path = self.path / "metrics" / f"{name}.csv"
+        new = rows[written:]
+        header: list[str] = []
+        if written > 0 and path.is_file():
+            with path.open(newline="") as fh:
+                header = next(csv.reader(fh), [])
+        if not header or any(list(r) != header for r in new):
+            columns: list[str] = []
+            for row in rows:
+                columns.extend(k for k in row if k not in columns)
+            write_atomic(path, _csv(rows, columns, header=True))
+        elif new:
+            with path.open("ab") as fh:
+                fh.write(_csv(new, header, header=False))
+                fh.flush()
+                os.fsync(fh.fileno())
+        return len(rows)
 
     def read_table(self, name: str) -> list[dict[str, Any]]:
         """Read ``metrics/<name>.csv`` back as rows of floats (ints where integral) and strings."""

@@ -197,15 +197,16 @@ def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, prog
     start = time.time()
     next_ckpt = (trainer.rounds_done // every + 1) * every
     writer = SummaryWriter(str(run.path / "tb"))
+    in_csv = 0  # rows in metrics/rounds.csv (rewritten whole at the first checkpoint, also after a resume)
 
     def on_step(scalars: dict[str, float]) -> None:
-        nonlocal next_ckpt
+        nonlocal next_ckpt, in_csv
         _log(writer, trainer, scalars, window)
         if next_ckpt <= trainer.rounds_done < total:
             arrays, meta = trainer.state()
             meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start)
             ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
-            run.write_table("rounds", trainer.rows)
+            in_csv = run.append_table("rounds", trainer.rows, in_csv)
             next_ckpt = (trainer.rounds_done // every + 1) * every
 
     try:

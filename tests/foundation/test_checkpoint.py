@@ -26,6 +26,31 @@ def test_round_trip_and_rng(tmp_path: Path) -> None:
     assert ck.latest(tmp_path) == path
 
 
+def test_tables_go_to_the_arrays_and_come_back_exactly(tmp_path: Path) -> None:
+    rows = [{"round": i + 1, "opponent": f"1v1:Bot{i % 3}", "share": i / 7, "won": i % 2 == 0,
+             "loss": float("nan") if i == 2 else -0.1 * i} for i in range(5)]
+    mixed = [{"a": 1}, {"a": None}]  # not one type per column: stays in the JSON
+    path = ck.save(tmp_path, "round-000005", {"w": np.ones(2)}, {"rounds_done": 5, "rows": rows, "mixed": mixed})
+    text = (path / "meta.json").read_text()
+    assert "Bot1" not in text and json.loads(text)["tables"] == {"rows": ["round", "opponent", "share", "won", "loss"]}
+    arrays, meta = ck.load(path)
+    assert set(arrays) == {"w"} and meta["mixed"] == mixed and "tables" not in meta
+    back = meta["rows"]
+    assert [list(r) for r in back] == [list(r) for r in rows]  # key order kept
+    for got, want in zip(back, rows, strict=True):
+        for k, v in want.items():
+            assert type(got[k]) is type(v)
+            assert got[k] == v or (v != v and got[k] != got[k])  # NaN stays NaN
+    with pytest.raises(ValueError, match="reserved"):
+        ck.save(tmp_path, "round-000006", {"table.x": np.ones(1)}, {})
+
+
+def test_table_rows_must_fit_rounds_done(tmp_path: Path) -> None:
+    path = ck.save(tmp_path, "round-000003", {"w": np.ones(2)}, {"rounds_done": 3, "rows": [{"r": 1}, {"r": 2}]})
+    with pytest.raises(ck.CheckpointError, match="holds 2 rows"):
+        ck.load(path)
+
+
 def test_truncated_checkpoint_is_refused(tmp_path: Path) -> None:
     path = _save(tmp_path, "round-000003", 1.0)
     npz = path / "state.npz"

@@ -23,6 +23,24 @@ def test_layout_and_tables(tmp_path: Path) -> None:
     assert json.loads((run.path / "summary.json").read_text()) == {"ratio": 0.5}
 
 
+def test_append_table_appends_and_rewrites_when_it_must(tmp_path: Path) -> None:
+    run = Run.create(tmp_path / "r")
+    rows = [{"round": i, "share": i / 4} for i in range(1, 4)]
+    assert run.append_table("rounds", rows[:2], 0) == 2
+    csv = run.path / "metrics" / "rounds.csv"
+    before = csv.stat().st_ino
+    assert run.append_table("rounds", rows, 2) == 3
+    assert csv.stat().st_ino == before  # appended in place, not rewritten
+    assert run.read_table("rounds") == rows
+    assert csv.read_text() == "round,share\n1,0.25\n2,0.5\n3,0.75\n"
+    # a resumed run (written 0) rewrites whole: rows past its checkpoint are gone
+    run.append_table("rounds", rows[:1], 0)
+    assert run.read_table("rounds") == rows[:1]
+    # new columns: rewritten whole with the union of the columns
+    run.append_table("rounds", [*rows[:1], {"round": 2, "share": 0.5, "won": True}], 1)
+    assert csv.read_text() == "round,share,won\n1,0.25,\n2,0.5,True\n"
+
+
 def test_existing_run_folder_is_not_overwritten(tmp_path: Path) -> None:
     Run.create(tmp_path / "r", {})
     with pytest.raises(FileExistsError, match="already exists"):

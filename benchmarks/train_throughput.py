@@ -14,10 +14,12 @@ from confront.experiments.tanks import TankTrainer
 
 
 def measure(opponents: list[str] | None, battles: int, updates: int, config: str = "tanks", overlap: bool = True,
-            threads: int = 2) -> dict[str, float | int | str]:
+            threads: int = 2, precision: str | None = None) -> dict[str, float | int | str]:
     """Run ``updates`` PPO updates after two warm-up ones (kernels compile; the first has no update before it);
     figures over the timed ones. ``opponents`` None: the config's own league (battles, focus) as it trains."""
     ov = [f"ppo.overlap={str(overlap).lower()}", f"ppo.threads={threads}"]
+    if precision is not None:
+        ov.append(f"ppo.precision={precision}")
     if opponents is not None:
         ov += [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", "league.focus=[]"]
     cfg = load_experiment(config, ov)
@@ -33,7 +35,8 @@ def measure(opponents: list[str] | None, battles: int, updates: int, config: str
     wall = time.perf_counter() - t0
     n = trainer.decisions - d0
     league = ",".join(opponents) if opponents is not None else f"its own ({len(cfg.league.opponents)} entries)"
-    return {"config": config, "overlap": overlap, "threads": threads, "league": league, "agents": trainer.pool.n_agents,
+    return {"config": config, "overlap": overlap, "threads": threads, "precision": cfg.ppo.precision, "league": league,
+            "agents": trainer.pool.n_agents,
             "decisions": n,
             "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
             "env_fraction": env / updates, "update_wait_fraction": upd / updates, "wall_s": wall}
@@ -44,20 +47,26 @@ def main() -> None:
     ap.add_argument("--updates", type=int, default=5)
     ap.add_argument("--battles", type=int, default=16)
     ap.add_argument("--threads", type=int, default=2, help="ppo.threads (the update's torch threads)")
+    ap.add_argument("--precision", choices=("fp32", "bf16"), help="ppo.precision (default: each config's own)")
+    ap.add_argument("--no-overlap", action="store_true", help="only the sequential schedule (the default one)")
     args = ap.parse_args()
     league = ["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"]
     teams = ["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"]
     rows = []
-    for overlap in (False, True):  # collect, then update (the default); or the update beside the next rollout
-        rows += [measure(None, 0, args.updates, overlap=overlap, threads=args.threads),
-                 measure(None, 0, args.updates, "tanks-demo", overlap=overlap, threads=args.threads),
-                 measure(league, args.battles * 2, args.updates, overlap=overlap, threads=args.threads),
-                 measure(teams, args.battles, args.updates, overlap=overlap, threads=args.threads)]
+    kw = {"threads": args.threads, "precision": args.precision}
+    # collect, then update (the default); or the update beside the next rollout
+    for overlap in (False,) if args.no_overlap else (False, True):
+        rows += [measure(None, 0, args.updates, overlap=overlap, **kw),
+                 measure(None, 0, args.updates, "tanks-demo", overlap=overlap, **kw),
+                 measure(league, args.battles * 2, args.updates, overlap=overlap, **kw),
+                 measure(teams, args.battles, args.updates, overlap=overlap, **kw)]
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print("| config | overlap | league | agents | decisions/s | decisions/CPU-s | env | update (or waiting for it) |")
-    print("|---|---|---|---:|---:|---:|---:|---:|")
+    print("| config | overlap | precision | league | agents | decisions/s | decisions/CPU-s | env | update (or waiting "
+          "for it) |")
+    print("|---|---|---|---|---:|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['config']} | {r['overlap']} | {r['league']} | {r['agents']} | {r['decisions_per_s']:,.0f} | "
+        print(f"| {r['config']} | {r['overlap']} | {r['precision']} | {r['league']} | {r['agents']} | "
+              f"{r['decisions_per_s']:,.0f} | "
               f"{r['decisions_per_cpu_s']:,.0f} | {r['env_fraction']:.0%} | {r['update_wait_fraction']:.0%} |")
     print(json.dumps({"bench": "train", "load": os.getloadavg()[0], "rows": rows}))
 

@@ -185,7 +185,8 @@ class LeagueSection:
         doc="SCENARIO:OPPONENT entries: a scripted robot (a team of it), td, random, dodge, strafe, or self "
         "(snapshots)")
     battles: int = field(8, ge=1, le=4096, doc="battles per entry")
-    focus: tuple[str, ...] = field((), doc="entries of opponents that get focus_weight times the battles")
+    focus: tuple[str, ...] = field((), doc="entries of opponents that get focus_weight times the battles; one "
+                                   "written ENTRY*W gets W times")
     focus_weight: int = field(3, ge=1, le=64, doc="battle multiplier of the focus entries")
     snapshot_every: int = field(20, ge=1, doc="updates between self-play snapshots")
     snapshots: int = field(5, ge=1, le=100, doc="snapshots kept; self-play battles sample one per update")
@@ -202,12 +203,19 @@ class LeagueSection:
         if not self.opponents:
             raise ValueError("league.opponents must not be empty")
         for e in self.focus:
-            if e not in self.opponents:
-                raise ValueError(f"league.focus entry {e!r} is not one of league.opponents")
+            name, star, w = e.partition("*")
+            if name not in self.opponents:
+                raise ValueError(f"league.focus entry {name!r} is not one of league.opponents")
+            if star and not (w.isdigit() and 1 <= int(w) <= 64):
+                raise ValueError(f"league.focus entry {e!r}: the weight after '*' must be an integer in 1..64")
 
     def battles_of(self, entry: str) -> int:
-        """Battles of one entry: ``battles``, times ``focus_weight`` for a focus entry."""
-        return self.battles * (self.focus_weight if entry in self.focus else 1)
+        """Battles of one entry: ``battles``, times ``focus_weight`` for a focus entry (times W for ENTRY*W)."""
+        for e in self.focus:
+            name, star, w = e.partition("*")
+            if name == entry:
+                return self.battles * (int(w) if star else self.focus_weight)
+        return self.battles
 
 
 @dataclass

@@ -181,6 +181,7 @@ def test_demo_contrast_windows_and_figure(tmp_path) -> None:
     ('league.opponents=["1v1:nope"]', "league.opponents entry '1v1:nope'"),
     ('tank.leads=["sideways"]', "tank.leads entry 'sideways'"),
     ("tank.fire_powers=[0.05]", "tank.fire_powers"),
+    ('league.focus=["1v1:SpinBot*x"]', "the weight after '*' must be an integer in 1..64"),
 ])
 def test_bad_tank_configs_are_one_line_errors(tmp_path, override: str, message: str) -> None:
     import subprocess
@@ -190,6 +191,12 @@ def test_bad_tank_configs_are_one_line_errors(tmp_path, override: str, message: 
                            "--out", str(tmp_path / "run")], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and message in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "run").exists()
+
+
+def test_focus_weights_per_entry() -> None:
+    league = load_experiment("tanks", ['league.focus=["4v4:td", "1v1:SpinBot*2"]', "league.battles=5",
+                                       "league.focus_weight=3"]).league
+    assert [league.battles_of(e) for e in ("4v4:td", "1v1:SpinBot", "1v1:Walls")] == [15, 10, 5]
 
 
 def test_polyak_average_is_a_config_key() -> None:

@@ -171,7 +171,8 @@ class PPOSection:
                          "than 1 on the idle 2-core machine; the float sums, hence the run's bits, depend on it")
     precision: Literal["fp32", "bf16"] = field(
         "fp32", doc="the update's hidden layers: fp32, or bf16 (bfloat16 products under autocast, float32 sums, "
-        "weights and output layers: 1.5x faster on CPUs with bfloat16 instructions, docs/learning.md)")
+        "weights and output layers: a 1.5x faster update on CPUs with bfloat16 instructions, but worse 1v1 play "
+        "where measured, docs/learning.md)")
 
 
 @dataclass

@@ -69,7 +69,8 @@ class PPOConfig:
     ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
     anneal_lr: bool = False  # the Adam step falls linearly from lr to 0 over the run (CleanRL's anneal_lr)
     precision: str = "fp32"  # the update's hidden layers: "fp32", or "bf16" (autocast: bfloat16 products, float32
-    # sums, weights and output layers; 1.6x faster where the CPU has bfloat16 instructions)
+    # sums, weights and output layers; 1.5x faster where the CPU has bfloat16 instructions, but measured to train
+    # worse 1v1 play: docs/learning.md)
 
     def __post_init__(self) -> None:
         if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:

@@ -169,10 +169,10 @@ class PPOSection:
                             "anneal_lr)")
     threads: int = field(2, ge=1, le=256, doc="torch threads of the update (acting uses one): 2 updates 1.7x faster "
                          "than 1 on the idle 2-core machine; the float sums, hence the run's bits, depend on it")
-    precision: Literal["fp32", "bf16"] = field(
-        "fp32", doc="the update's hidden layers: fp32, or bf16 (bfloat16 products under autocast, float32 sums, "
-        "weights and output layers: a 1.5x faster update on CPUs with bfloat16 instructions, but worse 1v1 play "
-        "where measured, docs/learning.md)")
+    precision: Literal["fp32", "bf16", "bf16-hidden"] = field(
+        "fp32", doc="the update's layers: fp32; bf16 (all but the output layer as bfloat16 products under autocast, "
+        "float32 sums and weights: a 1.5x faster update on CPUs with bfloat16 instructions, but worse 1v1 play where "
+        "measured); bf16-hidden (the hidden-to-hidden layer only); docs/learning.md")
 
 
 @dataclass

@@ -39,6 +39,7 @@ import torch
 from torch import nn
 
 IS_MAX = 2.0  # truncation of the behaviour -> proximal importance weight with ``overlap``
+PRECISIONS = ("fp32", "bf16", "bf16-hidden")  # ppo.precision: which layers multiply in bfloat16 (PPOConfig)
 UPDATE_STATS = ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance")
 
 __all__ = ["UPDATE_STATS", "entropy_coef", "learning_rate", "PPOConfig", "ActorCritic", "PPO", "Rollout", "Tanh",
@@ -68,9 +69,10 @@ class PPOConfig:
     overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
     ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
     anneal_lr: bool = False  # the Adam step falls linearly from lr to 0 over the run (CleanRL's anneal_lr)
-    precision: str = "fp32"  # the update's hidden layers: "fp32", or "bf16" (autocast: bfloat16 products, float32
-    # sums, weights and output layers; 1.5x faster where the CPU has bfloat16 instructions, but measured to train
-    # worse 1v1 play: docs/learning.md)
+    precision: str = "fp32"  # the update's layers: "fp32"; "bf16": every layer but the output one under bfloat16
+    # autocast (bfloat16 products, float32 sums, weights and output layers; 1.5x faster where the CPU has bfloat16
+    # instructions, but measured to train worse 1v1 play: docs/learning.md); "bf16-hidden": the hidden-to-hidden
+    # layer only (the features enter in float32)
 
     def __post_init__(self) -> None:
         if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:
@@ -85,8 +87,8 @@ class PPOConfig:
             v = getattr(self, name)
             if not lo <= v <= hi:
                 raise ValueError(f"ppo.{name} must be in [{lo}, {hi}], got {v!r}")
-        if self.precision not in ("fp32", "bf16"):
-            raise ValueError(f"ppo.precision must be fp32 or bf16, got {self.precision!r}")
+        if self.precision not in PRECISIONS:
+            raise ValueError(f"ppo.precision must be one of {', '.join(PRECISIONS)}, got {self.precision!r}")
         for name in ("lr", "reward_scale", "max_grad_norm"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"ppo.{name} must be > 0, got {getattr(self, name)!r}")
@@ -164,14 +166,14 @@ class ActorCritic(nn.Module):
         self.register_buffer("pad", torch.from_numpy(np.arange(width)[None, :] >= np.array(self.dims)[:, None]),
                              persistent=False)
 
-    def log_probs(self, obs: torch.Tensor, bf16: bool = False) -> torch.Tensor:
+    def log_probs(self, obs: torch.Tensor, precision: str = "fp32") -> torch.Tensor:
         """Per-head log-probabilities (N, H, max d), -inf beyond a head's d choices."""
-        z = _mlp(self.actor, obs, bf16).index_select(1, self.pad_index).view(len(obs), *self.pad.shape)
+        z = _mlp(self.actor, obs, precision).index_select(1, self.pad_index).view(len(obs), *self.pad.shape)
         return torch.log_softmax(z.masked_fill(self.pad, -torch.inf), dim=-1)
 
-    def value(self, critic_in: torch.Tensor, bf16: bool = False) -> torch.Tensor:
+    def value(self, critic_in: torch.Tensor, precision: str = "fp32") -> torch.Tensor:
         """V (N,)."""
-        return _mlp(self.critic, critic_in, bf16).squeeze(-1)
+        return _mlp(self.critic, critic_in, precision).squeeze(-1)
 
 
 def _bf16_fast() -> bool:
@@ -182,12 +184,15 @@ def _bf16_fast() -> bool:
         return False
 
 
-def _mlp(seq: nn.Sequential, x: torch.Tensor, bf16: bool) -> torch.Tensor:
-    """``seq(x)``; with ``bf16`` the hidden layers under bfloat16 autocast and the output layer in float32."""
-    if not bf16:
+def _mlp(seq: nn.Sequential, x: torch.Tensor, precision: str) -> torch.Tensor:
+    """``seq(x)`` (Linear, Tanh, Linear, Tanh, Linear) at a ``precision`` of :data:`PRECISIONS`: the layers from
+    the first (``bf16``) or the second (``bf16-hidden``) up to the output one under bfloat16 autocast."""
+    if precision == "fp32":
         return seq(x)
+    lo = 0 if precision == "bf16" else 2
+    h = seq[:lo](x)
     with torch.autocast("cpu", dtype=torch.bfloat16):
-        h = seq[:-1](x)
+        h = seq[lo:-1](h)
     return seq[-1](h.float())
 
 
@@ -253,9 +258,9 @@ class PPO:
         # acting runs between simulator steps on one thread; the update of the sequential schedule has the cores
         # to itself (:meth:`_learn` widens to ``threads``); with ``overlap`` both run beside the env at ``threads``
         self._act_threads = self.config.threads if self.config.overlap else 1
-        if self.config.precision == "bf16" and not _bf16_fast():
-            warnings.warn("ppo.precision = bf16 on a CPU without bfloat16 instructions (AVX512-BF16, AMX): the "
-                          "update runs, emulated and slower than fp32", stacklevel=2)
+        if self.config.precision != "fp32" and not _bf16_fast():
+            warnings.warn(f"ppo.precision = {self.config.precision} on a CPU without bfloat16 instructions "
+                          "(AVX512-BF16, AMX): the update runs, emulated and slower than fp32", stacklevel=2)
         torch.set_num_threads(self._act_threads)
         torch.manual_seed(seed)
         self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic)
@@ -369,7 +374,6 @@ class PPO:
                 prox_logp = self.net.log_probs(obs).gather(2, heads[:, :, None]).sum(dim=(1, 2))
             weight = (prox_logp - old_logp).exp().clamp(max=IS_MAX)  # behaviour -> proximal, truncated
         size = max(1, n // c.minibatches)
-        bf16 = c.precision == "bf16"
         count = 0
         ent_coef = entropy_coef(c, self.updates)
         for _ in range(c.epochs):
@@ -379,13 +383,13 @@ class PPO:
                 # index_select: 4-8x faster than advanced indexing here (same values)
                 mb_obs, mb_heads, mb_crit, mb_prox, a, mb_w, mb_old_v, mb_ret = (
                     t.index_select(0, idx) for t in (obs, heads, crit, prox_logp, adv_t, weight, old_v, ret_t))
-                lp = self.net.log_probs(mb_obs, bf16)
+                lp = self.net.log_probs(mb_obs, c.precision)
                 logp = lp.gather(2, mb_heads[:, :, None]).sum(dim=(1, 2))
                 entropy = -(lp.exp() * lp.masked_fill(self.net.pad, 0.0)).sum(dim=(1, 2)).mean()
                 ratio = (logp - mb_prox).exp()
                 a = (a - a.mean()) / (a.std() + 1e-8) if len(idx) > 1 else a
                 pg = (mb_w * torch.max(-a * ratio, -a * ratio.clamp(1 - c.clip, 1 + c.clip))).mean()
-                v = self.net.value(mb_crit, bf16)
+                v = self.net.value(mb_crit, c.precision)
                 v_clip = mb_old_v + (v - mb_old_v).clamp(-c.clip, c.clip)
                 vl = 0.5 * torch.max((v - mb_ret) ** 2, (v_clip - mb_ret) ** 2).mean()
                 loss = pg - ent_coef * entropy + c.vf_coef * vl

@@ -97,7 +97,7 @@ def test_bad_state_and_config_refused() -> None:
         PPOConfig(rollout_steps=0)
     with pytest.raises(ValueError, match="ppo.threads"):
         PPOConfig(threads=0)
-    with pytest.raises(ValueError, match="ppo.precision must be fp32 or bf16"):
+    with pytest.raises(ValueError, match="ppo.precision must be one of fp32, bf16, bf16-hidden"):
         PPOConfig(precision="fp16")
 
 
@@ -106,10 +106,12 @@ def test_bf16_update_learns_and_stays_near_fp32() -> None:
     update's step within a few percent of fp32's, and the bandit still learned."""
     ppo = PPO(2, (2, 3), PPOConfig(hidden=16, lr=3e-3, team_critic=False, ent_coef=0.0, precision="bf16"), seed=0)
     obs = torch.from_numpy(np.random.default_rng(2).standard_normal((64, 2)).astype(np.float32))
-    lp32, lp16 = ppo.net.log_probs(obs), ppo.net.log_probs(obs, bf16=True)
-    assert lp16.dtype == torch.float32 and ppo.net.value(obs, bf16=True).dtype == torch.float32
+    lp32, lp16 = ppo.net.log_probs(obs), ppo.net.log_probs(obs, "bf16")
+    assert lp16.dtype == torch.float32 and ppo.net.value(obs, "bf16").dtype == torch.float32
     fin = torch.isfinite(lp32)
     assert 0 < (lp16[fin] - lp32[fin]).abs().max() < 0.02  # not fp32's bits, within bf16's 2^-8
+    lph = ppo.net.log_probs(obs, "bf16-hidden")  # the first layer in float32: neither fp32's nor bf16's values
+    assert 0 < (lph[fin] - lp32[fin]).abs().max() < 0.02 and not torch.equal(lph, lp16)
     twin = PPO(2, (2, 3), PPOConfig(hidden=16, lr=3e-3, team_critic=False, ent_coef=0.0), seed=0)
     ro = _bandit_rollout(twin, np.random.default_rng(0))
     w0 = twin.net.actor[0].weight.detach().clone()

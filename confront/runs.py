@@ -55,6 +55,11 @@ def _clean(v: Any) -> Any:
     return v
 
 
+def _columns(rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """Every key of the rows, in order of first appearance."""
+    return list(dict.fromkeys(k for row in rows for k in row))
+
+
 def _csv(rows: Sequence[Mapping[str, Any]], columns: list[str], header: bool) -> bytes:
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
@@ -113,9 +118,7 @@ class Run:
         """Write ``metrics/<name>.csv`` (and ``.parquet``) atomically from a list of flat dict rows."""
         out = self.path / "metrics"
         out.mkdir(parents=True, exist_ok=True)
-        columns: list[str] = []
-        for row in rows:
-            columns.extend(k for k in row if k not in columns)
+        columns = _columns(rows)
         written = [out / f"{name}.csv"]
         write_atomic(written[0], _csv(rows, columns, header=True))
         if pa is not None and rows:
@@ -138,10 +141,7 @@ class Run:
             with path.open(newline="") as fh:
                 header = next(csv.reader(fh), [])
         if not header or any(list(r) != header for r in new):
-            columns: list[str] = []
-            for row in rows:
-                columns.extend(k for k in row if k not in columns)
-            write_atomic(path, _csv(rows, columns, header=True))
+            write_atomic(path, _csv(rows, _columns(rows), header=True))
         elif new:
             with path.open("ab") as fh:
                 fh.write(_csv(new, header, header=False))

@@ -210,13 +210,14 @@ class LeagueSection:
             if star and not (w.isdigit() and 1 <= int(w) <= 64):
                 raise ValueError(f"league.focus entry {e!r}: the weight after '*' must be an integer in 1..64")
 
+    def focus_weights(self) -> dict[str, int]:
+        """Battle multiplier of each focus entry: its own W (ENTRY*W) or ``focus_weight``."""
+        parts = [e.partition("*") for e in self.focus]
+        return {name: int(w) if star else self.focus_weight for name, star, w in parts}
+
     def battles_of(self, entry: str) -> int:
         """Battles of one entry: ``battles``, times ``focus_weight`` for a focus entry (times W for ENTRY*W)."""
-        for e in self.focus:
-            name, star, w = e.partition("*")
-            if name == entry:
-                return self.battles * (int(w) if star else self.focus_weight)
-        return self.battles
+        return self.battles * self.focus_weights().get(entry, 1)
 
 
 @dataclass

@@ -51,6 +51,7 @@ class PPOConfig:
     """PPO hyper-parameters (defaults: CleanRL's, with a larger batch for many agents)."""
 
     hidden: int = 128
+    critic_hidden: int = 0  # the critic's width; 0: ``hidden`` (the critic is half of the update's FLOPs)
     lr: float = 3e-4
     rollout_steps: int = 32  # S
     epochs: int = 4  # E
@@ -81,6 +82,8 @@ class PPOConfig:
             v = getattr(self, name)
             if not isinstance(v, int) or v < 1:
                 raise ValueError(f"ppo.{name} must be an integer >= 1, got {v!r}")
+        if not isinstance(self.critic_hidden, int) or self.critic_hidden < 0:
+            raise ValueError(f"ppo.critic_hidden must be an integer >= 0, got {self.critic_hidden!r}")
         if not 0 <= self.ema_decay < 1:
             raise ValueError(f"ppo.ema_decay must be in [0, 1), got {self.ema_decay!r}")
         for name, lo, hi in (("gamma", 0, 1), ("gae_lambda", 0, 1), ("clip", 0, 10)):
@@ -147,17 +150,19 @@ def _layer(n_in: int, n_out: int, gain: float) -> nn.Linear:
 
 
 class ActorCritic(nn.Module):
-    """Actor: F -> H -> H -> sum(dims) logits (tanh); critic: (F or 2F) -> H -> H -> 1 (tanh)."""
+    """Actor: F -> H -> H -> sum(dims) logits (tanh); critic: (F or 2F) -> Hc -> Hc -> 1 (tanh), Hc =
+    ``critic_hidden`` or H."""
 
-    def __init__(self, n_features: int, dims: tuple[int, ...], hidden: int, team_critic: bool) -> None:
+    def __init__(self, n_features: int, dims: tuple[int, ...], hidden: int, team_critic: bool,
+                 critic_hidden: int = 0) -> None:
         super().__init__()
         self.dims = tuple(int(d) for d in dims)
         g = float(np.sqrt(2))
         self.actor = nn.Sequential(_layer(n_features, hidden, g), Tanh(), _layer(hidden, hidden, g), Tanh(),
                                    _layer(hidden, sum(self.dims), 0.01))
         n_crit = 2 * n_features if team_critic else n_features
-        self.critic = nn.Sequential(_layer(n_crit, hidden, g), Tanh(), _layer(hidden, hidden, g), Tanh(),
-                                    _layer(hidden, 1, 1.0))
+        hc = critic_hidden or hidden
+        self.critic = nn.Sequential(_layer(n_crit, hc, g), Tanh(), _layer(hc, hc, g), Tanh(), _layer(hc, 1, 1.0))
         # the heads' logits laid out as (H, max d) through one gather; the padding is masked to -inf
         width = max(self.dims)
         starts = np.cumsum((0,) + self.dims[:-1])
@@ -263,7 +268,8 @@ class PPO:
                           "(AVX512-BF16, AMX): the update runs, emulated and slower than fp32", stacklevel=2)
         torch.set_num_threads(self._act_threads)
         torch.manual_seed(seed)
-        self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic)
+        self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic,
+                               self.config.critic_hidden)
         self.opt = torch.optim.Adam(self.net.parameters(), lr=self.config.lr, eps=1e-5)
         self.gen = torch.Generator().manual_seed(seed)  # minibatch order
         self.act_gen = torch.Generator().manual_seed(seed + 1)  # action sampling (its own stream: acting and

@@ -99,6 +99,21 @@ def test_bad_state_and_config_refused() -> None:
         PPOConfig(threads=0)
     with pytest.raises(ValueError, match="ppo.precision must be one of fp32, bf16, bf16-hidden"):
         PPOConfig(precision="fp16")
+    with pytest.raises(ValueError, match="ppo.critic_hidden must be an integer >= 0"):
+        PPOConfig(critic_hidden=-1)
+
+
+def test_critic_hidden_sizes_the_critic_only() -> None:
+    """``critic_hidden`` narrows the critic; the actor (what is exported) is drawn as without it; a state of
+    the other width is refused."""
+    wide = PPO(3, (2, 3), PPOConfig(hidden=16), seed=4)
+    narrow = PPO(3, (2, 3), PPOConfig(hidden=16, critic_hidden=4), seed=4)
+    assert [tuple(p.shape) for p in narrow.net.critic.parameters()] == [(4, 6), (4,), (4, 4), (4,), (1, 4), (1,)]
+    for a, b in zip(wide.net.actor.parameters(), narrow.net.actor.parameters(), strict=True):
+        assert torch.equal(a, b)
+    assert narrow.state_dict()["net.critic.0.weight"].shape == (4, 6)
+    with pytest.raises(ValueError, match="does not fit"):
+        wide.load_state_dict(narrow.state_dict())
 
 
 def test_bf16_update_learns_and_stays_near_fp32() -> None:

@@ -27,6 +27,7 @@ from confront.arena.observe import ObservationConfig
 from confront.engine.bridge import Observation, RobotActing, TurnEnergy
 from confront.engine.export import ExportedPolicy
 from confront.learning.base import Learner, Transition
+from confront.learning.exploration import ExplorationParams
 from confront.learning.tabular import TabularQ
 
 
@@ -94,6 +95,7 @@ class LearnerPolicy:
         self._sync = False  # a robot_acting() copy exists: queue every change of the Q table
         self._text: tuple[list[str], list[str]] | None = None  # the policy file: head lines, one line per Q row
         self._text_step = -1  # the learner's step the cached rows belong to
+        self._explore: ExplorationParams | None = None  # the tabular learner's exploration (robot_acting)
         # the twin builds the learner's observation; its Q table is never used
         self._twin = ExportedPolicy("qtable", q=np.zeros((320, 4)), observation=self.obs_config,
                                     control=self.control, step_turns=step_turns)
@@ -123,7 +125,7 @@ class LearnerPolicy:
         if not isinstance(learner, TabularQ) or learner.q.shape != (320, 4):
             return None
         self._sync = True
-        explore = learner.params.exploration_params()
+        explore = self._explore = learner.params.exploration_params()
         kind = "greedy" if not self.explore else "boltzmann" if explore.kind == "boltzmann" else "egreedy"
 
         def model() -> str:
@@ -140,7 +142,7 @@ class LearnerPolicy:
 
     def _param(self) -> float:
         """The learner's exploration parameter now: the temperature (Boltzmann) or the exploitation threshold."""
-        explore = self.learner.params.exploration_params()  # type: ignore[attr-defined]
+        explore = self._explore  # the learner's (frozen) parameters, made once by robot_acting
         step = self.learner.step  # type: ignore[attr-defined]
         return explore.temperature(step) if explore.kind == "boltzmann" else explore.threshold(step)
 
@@ -158,12 +160,15 @@ class LearnerPolicy:
 
     def _learn(self, tank: _Tank, next_obs: np.ndarray, done: bool) -> None:
         if self.train and tank.obs is not None and tank.rewards:
-            self.learner.learn(Transition(tank.obs, np.array([tank.action]), np.array([tank.rewards]), next_obs,
-                                          np.array([done])))
+            if isinstance(self.learner, TabularQ):  # one transition on Python numbers: the same bits, 4x cheaper
+                self.learner.learn_one(int(tank.obs[0]), tank.action, tank.rewards, int(next_obs[0]), done)
+            else:
+                self.learner.learn(Transition(tank.obs, np.array([tank.action]), np.array([tank.rewards]),
+                                              next_obs, np.array([done])))
             self.updates += 1
             if self._sync:  # the robots' copies: the row that changed, and the exploration parameter now
                 s = int(tank.obs[0])
-                row = " ".join(repr(float(v)) for v in self.learner.q[s])  # type: ignore[attr-defined]
+                row = " ".join(map(repr, self.learner.q[s].tolist()))  # type: ignore[attr-defined]
                 self._updates.append(f"Q {s} {row}")
                 if self._text is not None and self._text_step == self.learner.step - 1:  # type: ignore[attr-defined]
                     self._text[1][s] = row  # the policy file of the next hello, kept current row by row

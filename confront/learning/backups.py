@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
-__all__ = ["BACKUPS", "BOOTSTRAPS", "bootstrap_values", "intermediate_values", "smdp_target"]
+__all__ = ["BACKUPS", "BOOTSTRAPS", "bootstrap_values", "intermediate_values", "pairwise_sum", "paper_target_one",
+           "smdp_target"]
 
 BACKUPS = ("paper", "smdp")
 BOOTSTRAPS = ("expected", "max")
@@ -47,3 +50,52 @@ def smdp_target(rewards: np.ndarray, bootstrap: np.ndarray, gamma: float, backup
     if t == 1:
         return qs[:, 0]
     return (rewards[:, 0] + qs[:, 1:].sum(axis=1)) / t  # Eq. 10: (r_t + sum_{k=1}^{T-1} Q_{t+k}) / T
+
+
+def pairwise_sum(xs: Sequence[float], start: int = 0) -> float:
+    """``np.sum`` of the float64 values ``xs[start:]`` computed on Python floats in NumPy's order, so it is the
+    same double: the reduction starts from +0.0 and adds the pairwise sum of NumPy's add loop (a plain loop from
+    -0.0 below 8 values, eight running sums up to 128, halves beyond). For the one-transition paths that must
+    give the batched NumPy path's bits without its per-call cost (a test checks lengths 1-300 against np.sum)."""
+    return 0.0 + _pairwise(xs, start, len(xs) - start)
+
+
+def _pairwise(xs: Sequence[float], start: int, n: int) -> float:
+    if n < 8:
+        res = -0.0
+        for i in range(start, start + n):
+            res += xs[i]
+        return res
+    if n <= 128:
+        r0, r1, r2, r3, r4, r5, r6, r7 = xs[start:start + 8]
+        i, end = start + 8, start + n - n % 8
+        while i < end:
+            r0 += xs[i]
+            r1 += xs[i + 1]
+            r2 += xs[i + 2]
+            r3 += xs[i + 3]
+            r4 += xs[i + 4]
+            r5 += xs[i + 5]
+            r6 += xs[i + 6]
+            r7 += xs[i + 7]
+            i += 8
+        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        for j in range(i, start + n):
+            res += xs[j]
+        return res
+    half = n // 2
+    half -= half % 8
+    return _pairwise(xs, start, half) + _pairwise(xs, start + half, n - half)
+
+
+def paper_target_one(rewards: Sequence[float], bootstrap: float, gamma: float) -> float:
+    """``smdp_target`` with ``backup="paper"`` for one transition on Python floats: the same double."""
+    t = len(rewards)
+    qs = [0.0] * t
+    nxt = bootstrap
+    for i in range(t - 1, -1, -1):
+        nxt = rewards[i] + gamma * nxt  # Eq. 9 and Eq. 8, as intermediate_values
+        qs[i] = nxt
+    if t == 1:
+        return qs[0]
+    return (rewards[0] + pairwise_sum(qs, 1)) / t  # Eq. 10

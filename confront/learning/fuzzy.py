@@ -128,6 +128,8 @@ class FuzzyLearningRate:
         self._lo, self._hi = float(lo), float(hi)
         self._inv_step = (self.params.grid_size - 1) / (hi - lo)
         self._slope = np.diff(self.table)
+        self._n = self.table.shape[0]
+        self._table_list, self._slope_list = self.table.tolist(), self._slope.tolist()
 
     def __call__(self, reward: float | np.ndarray) -> float | np.ndarray:
         r = np.asarray(reward, dtype=np.float64)
@@ -135,6 +137,13 @@ class FuzzyLearningRate:
         i = np.minimum(u.astype(np.intp), self.table.shape[0] - 2)
         out = self.table[i] + (u - i) * self._slope[i]  # linear interpolation on the uniform grid
         return float(out) if out.ndim == 0 else out
+
+    def scalar(self, reward: float) -> float:
+        """``self(reward)`` for one finite float, on Python floats (the same double, without NumPy's per-call
+        cost; a test checks this)."""
+        u = (min(max(reward, self._lo), self._hi) - self._lo) * self._inv_step
+        i = min(int(u), self._n - 2)
+        return self._table_list[i] + (u - i) * self._slope_list[i]
 
     def exact(self, reward: float | np.ndarray, backend: str = "skfuzzy") -> np.ndarray:
         """Untabulated inference (``skfuzzy`` or ``numpy``), for checking the table."""

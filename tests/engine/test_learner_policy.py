@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -100,10 +101,10 @@ def test_acting_robots_learn_from_the_moves_taken_and_get_every_change() -> None
     after it are queued for the robots, and the policy file of the next hello is the table as it is then."""
     learned: list[int] = []
 
-    class Spy(TabularQ):
-        def learn(self, batch: Transition) -> dict[str, float]:
-            learned.append(int(batch.action[0]))
-            return super().learn(batch)
+    class Spy(TabularQ):  # a tabular learner learns one transition at a time (learn_one: learn's bits)
+        def learn_one(self, s: int, a: int, rewards: Sequence[float], s_next: int, done: bool) -> dict[str, float]:
+            learned.append(a)
+            return super().learn_one(s, a, rewards, s_next, done)
 
     learner = Spy()
     pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2)

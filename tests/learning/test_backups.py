@@ -33,3 +33,37 @@ def test_bootstrap_expected_and_max_and_done():
 def test_unknown_backup_is_rejected():
     with pytest.raises(ValueError, match="backup"):
         smdp_target(np.zeros((1, 2)), np.zeros(1), 0.9, "nstep")
+
+
+@pytest.mark.parametrize("n", [*range(1, 40), 127, 128, 129, 200, 256, 300])
+def test_pairwise_sum_is_numpys_sum_bit_for_bit(n):
+    from confront.learning.backups import pairwise_sum
+
+    rng = np.random.default_rng(n)
+    for _ in range(50):
+        a = rng.standard_normal(n) * 10.0 ** rng.integers(-6, 6, n)  # magnitudes apart: the order shows
+        assert pairwise_sum(a.tolist()).hex() == float(a.sum()).hex()
+        assert pairwise_sum(a.tolist(), 1).hex() == float(a[None, 1:].sum(axis=1)[0]).hex()
+    zeros = [-0.0] * n
+    assert pairwise_sum(zeros).hex() == float(np.sum(zeros)).hex() == "0x0.0p+0"  # +0.0, as NumPy's
+
+
+def test_pairwise_sum_order_by_hand():
+    from confront.learning.backups import pairwise_sum
+
+    # below 8 values left to right: 1e16 + 1 rounds back to 1e16 (the doubles there are 2 apart), twice
+    assert pairwise_sum([1e16, 1.0, 1.0]) == 1e16
+    # from 8 values on, pairs first: ((1e16 + 1) + (1 + 1)) + ((1 + 1) + (1 + 1)) = 1e16 + 6
+    assert pairwise_sum([1e16] + [1.0] * 7) == 1e16 + 6 == np.sum([1e16] + [1.0] * 7)
+
+
+@pytest.mark.parametrize("t", [1, 2, 3, 9, 10, 11, 17])
+def test_paper_target_one_is_smdp_target_bit_for_bit(t):
+    from confront.learning.backups import paper_target_one
+
+    rng = np.random.default_rng(t)
+    for _ in range(200):
+        r = rng.standard_t(3, (1, t)) * 5
+        v = rng.normal() * 10
+        assert paper_target_one(r[0].tolist(), v, 0.9).hex() == float(smdp_target(r, np.array([v]), 0.9, "paper")[0]).hex()
+    assert paper_target_one([1.0, 2.0, 3.0], 4.0, 0.5) == 3.5  # the three-step example above

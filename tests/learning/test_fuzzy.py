@@ -80,3 +80,11 @@ def test_bad_fuzzy_params_name_the_key():
 def test_plot_fuzzy_writes_png(tmp_path):
     out = plot_fuzzy(tmp_path / "fig13.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_fuzzy_scalar_is_the_array_path_bit_for_bit():
+    flr = FuzzyLearningRate()
+    rng = np.random.default_rng(0)
+    rewards = np.concatenate([rng.standard_t(2, 3000) * 20, flr.grid, [-1e9, 1e9, 0.0, -0.0]])
+    for r, rate in zip(rewards.tolist(), flr(rewards).tolist(), strict=True):
+        assert flr.scalar(r).hex() == rate.hex()

@@ -116,3 +116,43 @@ def test_bad_inputs_raise_clear_errors():
         make_learner("ssaq", alpha=0.0)
     with pytest.raises(ValueError, match="state_dict"):
         lr.load_state_dict({"q": np.zeros((3, 2)), "step": np.array(0), "last": np.zeros(2)})
+
+
+@pytest.mark.parametrize("kind,params", [
+    ("ssaq", {}),  # the paper's SSAQ: Boltzmann expectation, Eq. 10, fixed rate
+    ("ssaq", {"rate": "fuzzy"}),
+    ("ssaq", {"backup": "smdp", "bootstrap": "max"}),
+    ("ssaq", {"t_max": 5.0, "eta": 0.999}),  # a temperature that stays high: the expectation matters
+    ("qlearning_egreedy", {}),
+    ("qlearning_dgreedy", {"bootstrap": "expected", "rate": "fuzzy"}),
+])
+@pytest.mark.parametrize("t", [1, 3, 10])
+def test_learn_one_is_learn_on_a_batch_of_one_bit_for_bit(kind, params, t):
+    rng = np.random.default_rng(t)
+    batched = make_learner(kind, n_states=6, n_actions=4, **params)
+    one = make_learner(kind, n_states=6, n_actions=4, **params)
+    for k in range(600):
+        s, a, s2 = int(rng.integers(6)), int(rng.integers(4)), int(rng.integers(6))
+        r = rng.standard_t(3, t) * 5
+        r[rng.random(t) < 0.2] = 0.0
+        r[rng.random(t) < 0.1] = -0.0  # Eq. 35 gives -0.0 when we lose energy and the target does not
+        done = bool(rng.random() < 0.1)
+        before = one.q
+        out_b = batched.learn(_batch([s], [a], [r], [s2], [done]))
+        out_o = one.learn_one(s, a, r.tolist(), s2, done)
+        assert one.q.tobytes() == batched.q.tobytes(), f"step {k}"
+        assert out_o == out_b and one.step == batched.step == k + 1
+        assert one._last.tobytes() == batched._last.tobytes()
+        assert one.q is not before  # a new table, as table_update's
+    assert one.diagnostics() == batched.diagnostics()
+
+
+def test_learn_one_values_by_hand_and_bad_input():
+    lr = make_learner("qlearning_egreedy", n_states=2, n_actions=2, alpha=0.1, gamma=0.9)
+    lr.q[1] = [4.0, 10.0]
+    assert lr.learn_one(0, 0, [1.0], 1, False) == {"td_error": pytest.approx(10.0), "learning_rate": 0.1}
+    assert lr.q[0, 0] == pytest.approx(0.1 * (1 + 0.9 * 10.0))  # Eq. 4, as test_td_learner_one_step above
+    for bad in ((2, 0, [1.0], 0, False), (0, 2, [1.0], 0, False), (0, 0, [1.0], -1, False), (0, 0, [], 0, False)):
+        with pytest.raises(ValueError):
+            lr.learn_one(*bad)
+    assert lr.step == 1

@@ -186,14 +186,19 @@ def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: in
 @cli.command()
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Robots folder or .jar to write.")
-def export(run: Path, out: Path) -> None:
+@click.option("--play", type=click.Choice(["greedy", "sampled"]), default="greedy", show_default=True,
+              help="PPO tanks: the first maximum of each action head, or a draw from its softmax (Robocode's "
+              "seeded random).")
+def export(run: Path, out: Path, play: str) -> None:
     """Export a trained policy as a standalone Robocode robot (no Python needed to run it)."""
     from confront.engine.tank_export import export_tank_cli, is_tank_run
     from confront.experiments.evaluate import export_cli
 
     if is_tank_run(run):  # a PPO run over the tank view: confront.TankBot
-        export_tank_cli(run, out=out)
+        export_tank_cli(run, out=out, play=play)
         return
+    if play != "greedy":
+        raise click.UsageError("--play sampled is for PPO tank runs (paper policies play their own rule)")
     export_cli(run, out=out, name=None)
 
 

@@ -1,13 +1,14 @@
 """Exporting a tank policy (an actor over the tank view and tank actions, :mod:`confront.arena.tank`) as the
 standalone Robocode robot ``confront.TankBot``, with its Java inference (``TankModel.java``).
 :class:`TankPolicy` is the Python twin: the same view (the simulator's ``tank_view_row``, fed what the robot
-knows), the same greedy action and the same gun/radar controller (``smdp.controller_turn`` with
-``tank.lead_point``: no lead, linear, or circular with the turn rate of ``observe.remember_scans``).
+knows), the same action (greedy, or sampled from uniform draws: ``play``) and the same gun/radar controller
+(``smdp.controller_turn`` with ``tank.lead_point``: no lead, linear, or circular with the turn rate of
+``observe.remember_scans``).
 
-Policy file (text, data only): ``confront-tank 1``, ``key value`` lines (lists as space-separated values)
-and ``matrix NAME ROWS COLS`` blocks: ``w0 b0 w1 b1 ...``, weights as (out, in), tanh between layers, the
-last layer's outputs the logits of the five heads (distance, body turn, fire power, enemy slot, gun lead) in
-order.
+Policy file (text, data only): ``confront-tank 1``, ``key value`` lines (lists as space-separated values;
+``play sampled`` for a robot that samples its actions, greedy without it) and ``matrix NAME ROWS COLS``
+blocks: ``w0 b0 w1 b1 ...``, weights as (out, in), tanh between layers, the last layer's outputs the logits
+of the five heads (distance, body turn, fire power, enemy slot, gun lead) in order.
 
 A run trained on the tank view is exported when its ``model/model.json`` has ``"kind": "ppo"``: the actor
 is ``model/actor.npz`` (``w0, b0, w1, b1, ...`` as (out, in), or a torch state dict's
@@ -23,7 +24,7 @@ import math
 import re
 import tempfile
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,8 +36,8 @@ from confront.engine.export import ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
 from confront.results import BattleResults
 
-__all__ = ["TankPolicy", "robot_view", "robot_target", "robot_control", "body_turn", "turn_rate",
-           "export_tank_robot", "evaluate_tank_policy", "is_tank_run", "load_tank_policy", "TANK_CLASSES",
+__all__ = ["TankPolicy", "PLAYS", "sample_heads", "robot_view", "robot_target", "robot_control", "body_turn",
+           "turn_rate", "export_tank_robot", "evaluate_tank_policy", "is_tank_run", "load_tank_policy", "TANK_CLASSES",
            "TANK_ROBOT"]
 
 TANK_CLASSES = ("TankBot", "TankModel", "RoundStart")
@@ -44,6 +45,30 @@ TANK_ROBOT = "confront.TankBot 1.0"  # the exported jar's robot name
 EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time, turn rate
 MAX_RATE = math.pi / 18.0  # Rules.MAX_TURN_RATE, 10 deg/turn
 MateRow = Sequence[float]  # x, y, energy
+PLAYS = ("greedy", "sampled")  # TankPolicy.play: the first maximum of each head, or a draw from its softmax
+
+
+def sample_heads(logits: np.ndarray, dims: Sequence[int], u: Sequence[float]) -> int:
+    """Joint action with each head drawn from the softmax of its logits by one uniform draw in [0, 1): the
+    first choice whose running sum of probabilities (exp(z - max z), divided by their sum, in float64) exceeds
+    the draw, else the last (TankModel.sample does the same)."""
+    if len(u) != len(dims):
+        raise ValueError(f"sampling needs one draw per head ({len(dims)}), got {len(u)}")
+    joint, off = 0, 0
+    for n, draw in zip(dims, u, strict=True):
+        z = logits[off:off + n]
+        top = max(float(v) for v in z)
+        w = [math.exp(float(v) - top) for v in z]
+        total = sum(w)
+        pick, acc = n - 1, 0.0
+        for i in range(n):
+            acc += w[i] / total
+            if draw < acc:
+                pick = i
+                break
+        joint = joint * n + pick
+        off += n
+    return joint
 
 
 def robot_view(own: Sequence[float], counts: Sequence[int], enemies: Sequence[EnemyRow], mates: Sequence[MateRow],
@@ -154,16 +179,20 @@ def robot_control(control: ControlConfig, lead: str, x: float, y: float, gun_hea
 
 @dataclass(frozen=True)
 class TankPolicy:
-    """A greedy tank policy: the actor MLP (weights (out, in), tanh hidden layers, linear logits) over the
-    tank view, its TankSpace, the controller's settings and the step length in turns."""
+    """A tank policy: the actor MLP (weights (out, in), tanh hidden layers, linear logits) over the tank view,
+    its TankSpace, the controller's settings, the step length in turns and how it plays (``play``: greedy, or
+    sampled from each head's softmax)."""
 
     weights: tuple[np.ndarray, ...]
     biases: tuple[np.ndarray, ...]
     space: TankSpace = field(default_factory=TankSpace)
     control: ControlConfig = field(default_factory=ControlConfig)
     step_turns: int = 5
+    play: str = "greedy"
 
     def __post_init__(self) -> None:
+        if self.play not in PLAYS:
+            raise ValueError(f"play must be one of {', '.join(PLAYS)}, got {self.play!r}")
         if not isinstance(self.step_turns, int) or self.step_turns < 1:
             raise ValueError(f"step_turns must be an integer >= 1, got {self.step_turns!r}")
         if not self.weights or len(self.weights) != len(self.biases):
@@ -209,9 +238,14 @@ class TankPolicy:
                 h = np.tanh(h)
         return h
 
-    def act(self, view: np.ndarray) -> int:
-        """Greedy joint action (``np.ravel_multi_index`` over TankSpace.dims): the first maximum of each head."""
+    def act(self, view: np.ndarray, u: Sequence[float] | None = None) -> int:
+        """Joint action (``np.ravel_multi_index`` over TankSpace.dims): the first maximum of each head, or with
+        ``play`` sampled, :func:`sample_heads` with the uniform draws ``u`` (one per head)."""
         z = self.logits(view)
+        if self.play == "sampled":
+            if u is None:
+                raise ValueError("a sampling policy needs its uniform draws u (one per head)")
+            return sample_heads(z, self.space.dims, u)
         joint, off = 0, 0
         for n in self.space.dims:
             joint = joint * n + int(np.argmax(z[off:off + n]))
@@ -237,6 +271,8 @@ class TankPolicy:
                  f"turns_deg {nums(s.turns_deg)}", f"turn_mode {s.turn_mode}",
                  f"fire_powers {nums(s.fire_powers)}", f"enemy_slots {s.enemy_slots}",
                  f"mate_slots {s.mate_slots}", f"leads {' '.join(s.leads)}"]
+        if self.play != "greedy":
+            lines.append(f"play {self.play}")
         for f in fields(ControlConfig):
             v = getattr(self.control, f.name)
             lines.append(f"{f.name} {int(v) if isinstance(v, bool) else repr(float(v))}")
@@ -293,8 +329,8 @@ def is_tank_run(run: str | Path) -> bool:
     return isinstance(info, dict) and info.get("kind") == "ppo"
 
 
-def load_tank_policy(run: str | Path) -> TankPolicy:
-    """The greedy policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``."""
+def load_tank_policy(run: str | Path, play: str = "greedy") -> TankPolicy:
+    """The policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``, playing ``play``."""
     folder = _model_dir(run)
     cfg = json.loads((folder / "tank.json").read_text(encoding="utf-8"))
     tank_cfg = cfg.get("tank", cfg)
@@ -309,14 +345,14 @@ def load_tank_policy(run: str | Path) -> TankPolicy:
         raise ValueError(f"{folder / 'tank.json'}: dims {cfg['dims']} do not match the action heads {space.dims}")
     with np.load(folder / "actor.npz", allow_pickle=False) as z:
         state = {k: z[k] for k in z.files}
-    return TankPolicy.from_state(state, space, control, int(step))
+    return replace(TankPolicy.from_state(state, space, control, int(step)), play=play)
 
 
-def export_tank_cli(run: str | Path, out: str | Path) -> Path:
-    """``confront export`` for a PPO run: write confront.TankBot and say where."""
+def export_tank_cli(run: str | Path, out: str | Path, play: str = "greedy") -> Path:
+    """``confront export`` for a PPO run: write confront.TankBot (playing ``play``) and say where."""
     import click
 
-    path = export_tank_robot(load_tank_policy(run), out)
+    path = export_tank_robot(load_tank_policy(run, play), out)
     click.echo(f"wrote the robot confront.TankBot to {path}: copy it into Robocode's robots folder "
                "(no Python needed to run it)")
     return path

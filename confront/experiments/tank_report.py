@@ -2,15 +2,15 @@
 (the exported TankBot, no Python) in the real engine, against the issue's targets.
 
     python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine [--unseen]
-        [--engine-runs K]] [--compare WORK]
+        [--engine-runs K]] [--compare WORK] [--play greedy|sampled]
 
 Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
-simulator share (``--rounds`` rounds, the mean over runs with a t-interval when there are 2 or more), and with
-``--engine`` the exported robot's share in Robocode over ``--engine-seeds`` battles of ``--rounds`` rounds
-per sample-robot and paper-move entry (the TD team, the dodge, random moves: exported PolicyBots), for the
-first run or the first ``--engine-runs`` runs (then also the mean of their run means with a t-interval, and
-how many runs reach the target). Engine battles are kept per run
-(``<run>/eval/engine-<rounds>.json``), so runs can be played by separate processes side by side first.
+(or with ``--play sampled`` the sampling) simulator share (``--rounds`` rounds, the mean over runs with a
+t-interval when there are 2 or more), and with ``--engine`` the exported robot's share in Robocode over
+``--engine-seeds`` battles of ``--rounds`` rounds per sample-robot and paper-move entry (the TD team, the
+dodge, random moves: exported PolicyBots), for the first run or the first ``--engine-runs`` runs (then also
+the mean of their run means with a t-interval, and how many runs reach the target). Engine battles are kept
+per run (``<run>/eval/engine-<rounds>.json``), so runs can be played by separate processes side by side first.
 Writes ``report.md``, ``results.json`` and the learning curves (share against decisions and against wall
 time, per opponent).
 """
@@ -97,12 +97,13 @@ def _curves(runs: list[Path], out: Path) -> list[Path]:
 
 def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int, cfg: Any = None) -> float:
     """The exported robot's score share in one Robocode battle of ``rounds`` rounds (engine ``seed``), kept in
-    ``<run>/eval/engine-<rounds>.json`` as soon as it is played (a long report that dies keeps its battles).
+    ``<run>/eval/engine-<rounds>.json`` (``engine-sampled-<rounds>.json`` for a sampling robot) as soon as it
+    is played (a long report that dies keeps its battles).
     A paper-move opponent (the TD team, the dodge, random moves) plays as the exported PolicyBot of the run's
     config ``cfg`` (:func:`confront.experiments.tanks.paper_move_robot`)."""
     from confront.engine.tank_export import evaluate_tank_policy
 
-    cache = run / "eval" / f"engine-{rounds}.json"
+    cache = run / "eval" / ("engine-" + ("sampled-" if policy.play == "sampled" else "") + f"{rounds}.json")
     got = json.loads(cache.read_text()) if cache.is_file() else {}
     key = f"{entry}@{seed}"
     if key not in got:
@@ -114,16 +115,17 @@ def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int, cfg
     return float(got[key])
 
 
-def greedy_shares(run: Path, cfg: Any, rounds: int) -> dict[str, float]:
-    """The run's greedy simulator share per league entry over ``rounds`` rounds (battle seed 10000), kept in
-    ``<run>/eval/greedy-<rounds>.json`` (a model is evaluated once, whichever report asks)."""
-    cache = run / "eval" / f"greedy-{rounds}.json"
+def sim_shares(run: Path, cfg: Any, rounds: int, play: str = "greedy") -> dict[str, float]:
+    """The run's simulator share per league entry over ``rounds`` rounds (battle seed 10000), playing greedy
+    or sampled, kept in ``<run>/eval/<play>-<rounds>.json`` (a model is evaluated once, whichever report
+    asks)."""
+    cache = run / "eval" / f"{play}-{rounds}.json"
     entries = list(cfg.league.opponents)
     if cache.is_file():
         got = json.loads(cache.read_text())
         if all(e in got for e in entries):
             return got
-    res = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000)
+    res = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000, explore=play == "sampled")
     shares = {e: res[e]["share"] for e in entries}
     cache.parent.mkdir(parents=True, exist_ok=True)
     cache.write_text(json.dumps(shares, indent=1))
@@ -131,19 +133,20 @@ def greedy_shares(run: Path, cfg: Any, rounds: int) -> dict[str, float]:
 
 
 def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int, unseen: bool = False,
-           compare_work: Path | None = None, engine_from: Path | None = None, engine_runs: int = 1
-           ) -> dict[str, Any]:
+           compare_work: Path | None = None, engine_from: Path | None = None, engine_runs: int = 1,
+           play: str = "greedy") -> dict[str, Any]:
     """Evaluate the runs and write the report; return the results (``unseen``: also the first run's exported
     robot in the engine against :data:`UNSEEN`, robots no league entry names; ``compare_work``: also the
     comparison with the baselines, :mod:`confront.experiments.tank_compare`, trained and cached there;
     ``engine_from``: the engine rows of an earlier ``results.json`` of the same first run, instead of playing;
-    ``engine_runs``: how many of the runs, from the first, play in the engine)."""
+    ``engine_runs``: how many of the runs, from the first, play in the engine; ``play``: the policy's actions,
+    greedy or sampled, in the simulator and the exported robot)."""
     out.mkdir(parents=True, exist_ok=True)
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
     entries = list(cfgs[0].league.opponents)
     sim: dict[str, list[float]] = {e: [] for e in entries}
     for run, cfg in zip(runs, cfgs, strict=True):
-        res = greedy_shares(run, cfg, rounds)
+        res = sim_shares(run, cfg, rounds, play)
         for e in entries:
             sim[e].append(res[e])
     real: dict[str, list[float]] = {}
@@ -152,9 +155,9 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
         from confront.arena.bots import BOT_NAMES
         from confront.engine.tank_export import load_tank_policy
 
-        policy = load_tank_policy(runs[0])
+        policy = load_tank_policy(runs[0], play)
         for i, run in enumerate(runs[:engine_runs]):
-            pol = policy if i == 0 else load_tank_policy(run)
+            pol = policy if i == 0 else load_tank_policy(run, play)
             for e in entries:
                 if e.partition(":")[2] in (*BOT_NAMES, *PAPER_MOVE_OPPONENTS):
                     real_runs.setdefault(e, []).append([engine_share(run, pol, e, rounds, k + 1, cfgs[i])
@@ -173,7 +176,7 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
             unseen_rows.append({"entry": e, "engine": [engine_share(runs[0], policy, e, rounds, k + 1)
                                                        for k in range(engine_seeds)]})
     summaries = [json.loads((r / "summary.json").read_text()) for r in runs]
-    result = {"runs": [r.name for r in runs], "rounds": rounds,
+    result = {"runs": [r.name for r in runs], "rounds": rounds, "play": play,
               "engine_seeds": engine_seeds if engine or engine_from is not None else 0,
               "trained": [{k: s[k] for k in ("rounds", "wall_time_s", "decisions")} for s in summaries],
               "engine_runs": [r.name for r in runs[:engine_runs]] if engine else [],
@@ -200,10 +203,11 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
         f"{', '.join(str(s['rounds']) for s in trained)} rounds in "
         f"{', '.join(format(s['wall_time_s'], '.0f') for s in trained)} s "
         f"({', '.join(format(s['decisions'], ',') for s in trained)} decisions).",
-        f"Simulator: the greedy policy, {rounds} rounds per opponent (battle seed 10000)"
+        f"Simulator: the {result.get('play', 'greedy')} policy, {rounds} rounds per opponent (battle seed 10000)"
         + (f"; mean and 95% t-interval over {len(runs)} training seeds, then the first run alone." if len(runs) > 1
            else "; one training seed, so no interval over seeds."),
-        (f"Engine: the exported `confront.TankBot` jar (no Python) in Robocode 1.9.3.9, {seeds} battles of "
+        (f"Engine: the exported `confront.TankBot` jar (no Python; playing {result.get('play', 'greedy')}) in "
+         f"Robocode 1.9.3.9, {seeds} battles of "
          f"{rounds} rounds per sample-robot and paper-move entry (engine seeds 1..{seeds}; the TD team, the dodge "
          "and random moves play as the exported `confront.PolicyBot`, random ties drawn with Math.random, which "
          "the engine's seed does not reach), the first run's policy; `sim - engine` compares that same policy."
@@ -272,6 +276,8 @@ def main() -> None:
                     help="also compare with the paper's method, SB3 PPO and random moves (baselines cached in WORK)")
     ap.add_argument("--engine-from", type=Path, default=None, metavar="RESULTS_JSON",
                     help="take the engine rows from an earlier results.json of the same first run")
+    ap.add_argument("--play", choices=("greedy", "sampled"), default="greedy",
+                    help="the policy's actions in the simulator and the exported robot (default: greedy)")
     args = ap.parse_args()
     if args.rounds < 1 or args.engine_seeds < 1 or not 1 <= args.engine_runs <= len(args.runs):
         ap.error("--rounds and --engine-seeds must be at least 1, --engine-runs between 1 and the number of runs")
@@ -281,7 +287,7 @@ def main() -> None:
         if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
             ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")
     res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds, args.unseen, args.compare,
-                 args.engine_from, args.engine_runs)
+                 args.engine_from, args.engine_runs, args.play)
     print((args.out / "report.md").read_text())
     print(json.dumps({"report": str(args.out / "report.md"), "entries": len(res["rows"])}))
 

@@ -439,8 +439,10 @@ def share_windows(rows: list[dict[str, Any]], size: int) -> list[tuple[int, floa
 
 
 def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_000,
-                   opponents: tuple[str, ...] | None = None, battles: int = 16) -> dict[str, dict[str, float]]:
-    """Greedy play against each league entry for ``rounds`` rounds: share (pooled) and win rate per entry."""
+                   opponents: tuple[str, ...] | None = None, battles: int = 16, explore: bool = False
+                   ) -> dict[str, dict[str, float]]:
+    """Greedy play (sampled with ``explore``) against each league entry for ``rounds`` rounds: share (pooled)
+    and win rate per entry."""
     from dataclasses import replace
 
     league = replace(cfg.league, opponents=opponents or cfg.league.opponents, focus=())
@@ -451,7 +453,7 @@ def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_
     rows: list[dict[str, Any]] = []
     done = {e.name: 0 for e in pool.entries}
     while min(done.values()) < rounds:
-        joint, *_ = ppo.act(obs, explore=False)
+        joint, *_ = ppo.act(obs, explore=explore)
         st = pool.step(joint)
         for r in st.rounds:
             if done[r["opponent"]] < rounds:

@@ -1,5 +1,5 @@
-"""The exported tank robot: its Java view, greedy action and controller equal the Python twin's, the twin's
-equal the simulator's on recorded battles, and the exported robot plays in the real engine."""
+"""The exported tank robot: its Java view, greedy and sampled actions and controller equal the Python twin's,
+the twin's equal the simulator's on recorded battles, and the exported robot plays in the real engine."""
 
 from __future__ import annotations
 
@@ -27,6 +27,7 @@ from confront.engine.tank_export import (
     robot_control,
     robot_target,
     robot_view,
+    sample_heads,
     turn_rate,
 )
 
@@ -232,6 +233,47 @@ def test_java_greedy_actions_equal_python(install, views, tmp_path) -> None:
         assert all(len({h[i] for h in heads}) > 1 for i in range(5)), heads  # several choices per head
 
 
+def test_sample_heads_hand_computed_and_its_frequencies() -> None:
+    # head 0: logits (0, ln 3) -> p = (1/4, 3/4); head 1: (0, 0, 0) -> 1/3 each; joint = h0 * 3 + h1
+    z = np.array([0.0, math.log(3.0), 5.0, 5.0, 5.0])
+    assert sample_heads(z, (2, 3), [0.2, 0.5]) == 0 * 3 + 1
+    assert sample_heads(z, (2, 3), [0.3, 0.99]) == 1 * 3 + 2
+    assert sample_heads(z, (2, 3), [0.249, 0.0]) == 0 and sample_heads(z, (2, 3), [0.251, 0.34]) == 3 + 1
+    with pytest.raises(ValueError, match="one draw per head"):
+        sample_heads(z, (2, 3), [0.5])
+    p = _policy(8)
+    sampled = TankPolicy(p.weights, p.biases, p.space, p.control, p.step_turns, play="sampled")
+    view = np.random.default_rng(1).uniform(-1, 1, SPACE.n_features)
+    rng = np.random.default_rng(2)
+    n = 20000
+    heads = np.array([np.unravel_index(sampled.act(view, rng.random(5)), SPACE.dims) for _ in range(n)])
+    zl, off = sampled.logits(view), 0
+    for h, d in enumerate(SPACE.dims):
+        want = np.exp(zl[off:off + d] - zl[off:off + d].max())
+        want /= want.sum()
+        got = np.bincount(heads[:, h], minlength=d) / n
+        assert np.abs(got - want).max() < 4 * math.sqrt(0.25 / n), (h, got, want)  # 4 standard errors
+        off += d
+    assert "play sampled" in sampled.to_text() and "play" not in p.to_text()
+    with pytest.raises(ValueError, match="uniform draws"):
+        sampled.act(view)
+    with pytest.raises(ValueError, match="play must be one of greedy, sampled"):
+        TankPolicy(p.weights, p.biases, play="boltzmann")
+
+
+@pytest.mark.engine
+def test_java_sampled_actions_equal_python(install, views, tmp_path) -> None:
+    rng = np.random.default_rng(4)
+    policy = _policy(3)
+    policy = TankPolicy(policy.weights, policy.biases, policy.space, policy.control, policy.step_turns, "sampled")
+    inputs = [(f, rng.random(5)) for _, f, _ in views[:300]] + [(rng.uniform(-1, 1, SPACE.n_features),
+                                                                  rng.random(5)) for _ in range(300)]
+    out = _java(install, policy, [f"S\t{_nums(v)}\t{_nums(u)}" for v, u in inputs], tmp_path)
+    acts = [int(line) for line in out]
+    assert acts == [policy.act(v, u) for v, u in inputs]
+    assert len(set(acts)) > 100  # draws, not one greedy answer
+
+
 @pytest.mark.engine
 @pytest.mark.parametrize("lead", ["none", "linear", "circular"])
 def test_java_controller_equals_python(install, controls, tmp_path, lead) -> None:
@@ -340,6 +382,31 @@ def test_exported_tank_robot_plays(install, tmp_path) -> None:
     assert not [r for r in reports if "tank-error" in r or "tank-load-failed" in r or "Exception" in r], reports
     rounds = [r for r in reports if "tank-round" in r]
     assert rounds and int(rounds[0].split("decisions=")[1].split()[0]) > 10, reports
+
+
+@pytest.mark.engine
+def test_exported_sampling_robot_plays_and_repeats_with_the_engine_seed(install, tmp_path) -> None:
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+    from confront.engine.battle import BattleSpec
+    from confront.engine.runner import EngineOptions, run_battle
+
+    _write_run(tmp_path / "run", _policy(6))
+    jar = tmp_path / "out" / "tankbot.jar"
+    res = CliRunner().invoke(cli, ["export", str(tmp_path / "run"), "--out", str(jar), "--play", "sampled"])
+    assert res.exit_code == 0, res.output
+    assert "play sampled" in zipfile.ZipFile(jar).read("confront/tank_policy.txt").decode()
+    scores = []
+    for seed in (3, 3, 4):
+        run = run_battle(BattleSpec(("confront.TankBot 1.0", "sample.Walls"), rounds=2), EngineOptions(seed=seed),
+                         extra_robots=[jar])
+        reports = run.summary["robot_reports"]
+        assert not run.errors and run.results.rounds == 2
+        assert not [r for r in reports if "tank-error" in r or "tank-load-failed" in r or "Exception" in r], reports
+        scores.append([(c.name, c.total, c.bullet_dmg) for c in run.results.contestants])
+    assert scores[0] == scores[1]  # Robocode's random, which the robot draws from, follows the battle's seed
+    assert scores[0] != scores[2]
 
 
 @pytest.mark.engine

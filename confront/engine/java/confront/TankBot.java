@@ -16,13 +16,15 @@ import robocode.RobotDeathEvent;
 import robocode.RoundEndedEvent;
 import robocode.ScannedRobotEvent;
 import robocode.TeamRobot;
+import robocode.util.Utils;
 
 /**
  * A tank policy trained with confront (PPO over the tank view and tank actions), running with no Python.
  * Its policy is compiled into confront.TankData at export. Every step_turns turns it builds the tank view
  * (confront.arena.tank) from what it knows: its own getters, the last ScannedRobotEvent of each living enemy
  * this round (position, energy, heading, velocity, the energy drop and turn rate since the previous scan, the
- * scan time) and the latest (x, y, energy) each living team-mate broadcast; it picks the greedy tank action
+ * scan time) and the latest (x, y, energy) each living team-mate broadcast; it picks the greedy tank action (or,
+ * exported with play sampled, draws it from the policy with Robocode's seeded random)
  * (move, body turn by an angle or to an angle from the target's bearing, fire power or hold, target slot, gun
  * lead). Every turn the gun/radar controller aims at the chosen target (the nearest known enemy when that one
  * is unknown or dead), with the step's lead (none, linear or circular).
@@ -80,7 +82,7 @@ public class TankBot extends TeamRobot {
                             getGunHeat(), Math.max(getOthers() - matesAlive, 0), enemiesStart, matesAlive,
                             matesStart, known, mates.values().toArray(new double[0][]), time,
                             getBattleFieldWidth(), getBattleFieldHeight(), slots);
-                    a = model.decode(model.act(v));
+                    a = model.decode(model.sampled() ? model.sample(v, draws(model.dims().length)) : model.act(v));
                     power = a[2];
                     lead = (int) a[4];
                     int k = (int) a[3];
@@ -115,6 +117,16 @@ public class TankBot extends TeamRobot {
             }
             execute();
         }
+    }
+
+    /** One uniform draw in [0, 1) per action head from Robocode's random (seeded by the battle's seed). */
+    private static double[] draws(int heads) {
+        java.util.Random rng = Utils.getRandom();
+        double[] u = new double[heads];
+        for (int i = 0; i < heads; i++) {
+            u[i] = rng.nextDouble();
+        }
+        return u;
     }
 
     /** The policy compiled into confront.TankData (written at export), else tank_policy.txt beside the class. */

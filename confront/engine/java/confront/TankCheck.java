@@ -12,6 +12,7 @@ import java.io.InputStreamReader;
  * <li>"V own enemies mates", own = x y heading velocity energy gunHeat enemiesAlive enemiesStart matesAlive
  * matesStart time width height; prints the view, then "|" and the slots.</li>
  * <li>"A view"; prints the joint action, then "|" and the logits.</li>
+ * <li>"S view draws" (one uniform draw per head); prints the sampled joint action.</li>
  * <li>"C own enemies", own = x y heading gunHeading radarHeading gunHeat energy power chosen turn lead time
  * width height (lead: 0 none, 1 linear, 2 circular); prints gun radar fire target bodyTurn.</li>
  * <li>"R seen prevHeading prevTime heading time" (seen 0: no previous scan); prints the turn rate.</li>
@@ -74,6 +75,10 @@ public final class TankCheck {
                     for (double z : m.logits(v)) {
                         out.append(' ').append(z);
                     }
+                    break;
+                }
+                case "S": {
+                    out.append(m.sample(nums(parts[1]), nums(parts[2])));
                     break;
                 }
                 case "C": {

@@ -11,7 +11,7 @@ import java.util.Map;
 /**
  * An exported tank policy (no Robocode dependency): the tank view of confront.arena.tank.tank_view_row, the
  * actor MLP (tanh hidden layers, linear logits), the greedy tank action (argmax per head: distance, body turn,
- * fire power, enemy slot, gun lead) and the gun/radar controller of confront.arena.smdp.controller_turn with
+ * fire power, enemy slot, gun lead) or, with "play sampled", a draw from each head's softmax (sample), and the gun/radar controller of confront.arena.smdp.controller_turn with
  * the lead of confront.arena.tank.lead_point (none, linear or circular).
  * Mirrors confront.engine.tank_export.TankPolicy; the file format is written by its to_text().
  *
@@ -50,6 +50,7 @@ public final class TankModel {
     double nearDistance;
     double farDistance;
     boolean fire;
+    boolean sampled;  // "play sampled": act draws each head from its softmax (sample), else greedy (act)
 
     /** Reads a "confront-tank 1" policy file. */
     public static TankModel read(Reader source) throws IOException {
@@ -128,6 +129,11 @@ public final class TankModel {
         m.nearDistance = m.num("near_distance");
         m.farDistance = m.num("far_distance");
         m.fire = m.num("fire") != 0;
+        String play = m.keys.getOrDefault("play", "greedy");
+        if (!"greedy".equals(play) && !"sampled".equals(play)) {
+            throw new IOException("play must be greedy or sampled, got " + play);
+        }
+        m.sampled = "sampled".equals(play);
         m.check();
         return m;
     }
@@ -319,6 +325,47 @@ public final class TankModel {
             off += d[head];
         }
         return joint;
+    }
+
+    /**
+     * Joint action with each head drawn from the softmax of its logits by one uniform draw u[head] in [0, 1): the
+     * first choice whose running sum of probabilities (exp(z - max z) over their sum) exceeds the draw, else the
+     * last (tank_export.sample_heads).
+     */
+    public int sample(double[] view, double[] u) {
+        double[] z = logits(view);
+        int[] d = dims();
+        int joint = 0;
+        int off = 0;
+        for (int head = 0; head < d.length; head++) {
+            double top = z[off];
+            for (int i = 1; i < d[head]; i++) {
+                top = Math.max(top, z[off + i]);
+            }
+            double[] w = new double[d[head]];
+            double total = 0.0;
+            for (int i = 0; i < d[head]; i++) {
+                w[i] = StrictMath.exp(z[off + i] - top);
+                total += w[i];
+            }
+            int pick = d[head] - 1;
+            double acc = 0.0;
+            for (int i = 0; i < d[head]; i++) {
+                acc += w[i] / total;
+                if (u[head] < acc) {
+                    pick = i;
+                    break;
+                }
+            }
+            joint = joint * d[head] + pick;
+            off += d[head];
+        }
+        return joint;
+    }
+
+    /** Whether the policy file asks for sampled play ("play sampled"), else greedy. */
+    public boolean sampled() {
+        return sampled;
     }
 
     /**

@@ -502,6 +502,12 @@ def test_report_keeps_each_engine_battle(install, tmp_path) -> None:
     assert json.loads(cache.read_text()) == {"1v1:SittingDuck@1": share} and 0.0 <= share <= 1.0
     cache.write_text(json.dumps({"1v1:SittingDuck@1": 0.123}))
     assert engine_share(tmp_path, _policy(7), "1v1:SittingDuck", 1, 1) == 0.123  # read back, not played again
+    cache.write_text(json.dumps({"1v1:SittingDuck@1": 0.123}))
+    p = _policy(7)
+    sampled = TankPolicy(p.weights, p.biases, p.space, p.control, p.step_turns, play="sampled")
+    share = engine_share(tmp_path, sampled, "1v1:SittingDuck", 1, 1)  # its own cache, played
+    assert json.loads((tmp_path / "eval" / "engine-sampled-1.json").read_text()) == {"1v1:SittingDuck@1": share}
+    assert json.loads(cache.read_text()) == {"1v1:SittingDuck@1": 0.123}
 
 
 @pytest.mark.engine

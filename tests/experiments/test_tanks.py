@@ -227,6 +227,9 @@ def test_report_engine_over_runs(tmp_path) -> None:
     assert f"| {m:.3f} [{m - half:.3f}, {m + half:.3f}] | 2/3 |" in row and row.endswith("| 0.90 | yes |")
     assert "| engine, 3 runs | runs met |" in md and "Engine, 3 runs (a, b, c)" in md
     assert next(line for line in md.splitlines() if line.startswith("| 1v1:self")).endswith("| - | | - | |")
+    assert "Simulator: the greedy policy" in md and "playing greedy" in md  # results without "play": greedy
+    md = write_markdown({**result, "play": "sampled"}, tmp_path).read_text()
+    assert "Simulator: the sampled policy" in md and "(no Python; playing sampled)" in md
 
 
 def test_paper_move_values_have_the_opponents_choices_as_maxima() -> None:

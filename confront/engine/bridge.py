@@ -10,9 +10,10 @@ Protocol v2, one line per message (UTF-8). Robot -> Python:
   of the events since the last observation; HISTORY (empty unless asked for) one
   ``TIME;ENERGY;TARGET;TARGET_PREVIOUS;TARGET_ENERGY`` record per turn since the last observation, joined by
   "|" (:class:`TurnEnergy`); TURN is the engine turn the answer takes effect in; when the robot acts on its own
-  (ACTING below) a fifth field<TAB>MOVE;BEHIND carries the move (0-3) it took in that turn and how many of its
-  observations were still unacknowledged when it chose it (0: its copy had every update up to its last
-  observation), and nothing is answered;
+  (ACTING below) a fifth field<TAB>MOVE;BEHIND;AHEAD carries the move (0-3) it took in that turn, how many of
+  its observations were still unacknowledged when it chose it and counted for that move (WAIT below; 0: its
+  copy had every update up to its last observation that could change the move) and how many more were
+  unacknowledged but could not change it (the robot went on without waiting for them), and nothing is answered;
 - ``E ROUND TIME HOW ENERGY DECISIONS RTT_TOTAL_US RTT_OVER_1MS TURNS WORK_US<TAB>HISTORY`` at death or
   round end: the round's decisions, the time the robot was held up by their round trips and how many took
   over 1 ms, the turns played and the robot's own time outside ``execute()`` (deciding and the controller),
@@ -21,13 +22,15 @@ Python -> robot: ``OK 2 EVERY LEAD HISTORY(0/1) N [M]`` after a valid hello (:cl
 by N ``key value`` lines: the parameters of the fixed gun/radar controller
 (:class:`~confront.arena.control.ControlConfig`) that the robot then runs in Java every turn (N = 0: no
 controller, the answers' gun, radar and fire are used); then, when M is given, M lines: ``acting EXPLORE
-PARAM SEED MAX_LAG`` and the policy file of the robot's own copy of the policy (PolicyModel's, e.g. the
+PARAM SEED MAX_LAG WAIT FIXED`` and the policy file of the robot's own copy of the policy (PolicyModel's, e.g. the
 learner's current Q table), with which the robot then picks its moves itself (:class:`RobotActing`).
 ``A TURN AHEAD TURN GUN RADAR FIRE`` per observation when Python decides (radians, + clockwise; ``NaN`` keeps
 the remaining value; fire 0 = no shot). When the robot acts: ``K TURN`` acknowledges its observation of TURN
 once the policy has taken it in (the robot stops and waits, at most its timeout, when MAX_LAG observations
-are unacknowledged), and at any time, to every acting robot of the battle, ``Q STATE V0 V1 V2 V3`` (a row of
-the Q table changed) and ``X PARAM`` (the exploration parameter changed). Between decisions
+are unacknowledged; with WAIT ``row`` only those whose update could change the move it draws count,
+:class:`RobotActing`), and at any time, to every acting robot of the battle, ``Q STATE V0 V1 V2 V3`` (a row
+of the Q table changed) and ``X PARAM FIXED`` (the exploration parameter now; FIXED 1: it no longer changes,
+as in the hello's acting line). Between decisions
 the robot's commands keep running (remaining distance and turns) with no round trip. A compact text line
 instead of JSON keeps the cost low (measured: docs/engine.md). A robot whose Python side fails (no answer
 within its timeout, closed socket, bad line) plays a built-in behaviour for the rest of the round and
@@ -124,7 +127,8 @@ class Observation:
     events: tuple[dict[str, Any], ...] = ()
     history: tuple[TurnEnergy, ...] = ()  # with BridgeSettings.history: each turn since the last observation
     action: int = -1  # the move the robot took itself (BridgeSettings.acting); -1: the policy decides
-    behind: int = 0  # acting: the robot's observations not yet acknowledged when it chose that move
+    behind: int = 0  # acting: the robot's observations not yet acknowledged when it chose that move (that count)
+    ahead: int = 0  # acting, WAIT row: and those not yet acknowledged whose update could not change that move
 
     def enemies(self) -> tuple[Scan, ...]:
         """Scans of robots that are not team-mates."""
@@ -136,6 +140,7 @@ Policy = Callable[[Observation], Action]
 
 
 EXPLORE_KINDS = ("first", "greedy", "boltzmann", "egreedy")
+WAIT_KINDS = ("all", "row")
 
 
 @dataclass(frozen=True)
@@ -147,9 +152,15 @@ class RobotActing:
     from the move values: ``first`` (the first maximum, as the exported robot), ``greedy`` (a maximum, ties at
     random), ``boltzmann`` (softmax at temperature ``param()``), ``egreedy`` (greedy with probability
     ``param()``, else uniform). ``seed()``: the robot's random generator per connection. ``updates()``: the
-    lines (``Q STATE V0 V1 V2 V3``, ``X PARAM``) that bring every connected robot's copy up to date, drained
+    lines (``Q STATE V0 V1 V2 V3``, ``X PARAM FIXED``) that bring every connected robot's copy up to date, drained
     after each message the policy took in. ``max_lag``: a robot waits (at most its timeout) when this many of its
-    observations are not yet acknowledged, so its copy is never more than ``max_lag`` observations behind.
+    observations are not yet acknowledged, so its copy is never more than ``max_lag`` observations behind; with
+    ``wait="row"`` only the observations count whose update could change the move the robot is drawing: those
+    whose learned SMDP step starts in the state it decides in (a learner learns, at a robot's observation k, the
+    step from its decision k - 1, i.e. that state's row), and every one while the exploration parameter may still
+    change (``fixed()`` False; FIXED in the ``X`` lines: 1 once the parameter no longer changes). The rows the
+    others change are not read by that move, so with ``max_lag`` = 1 each move is still drawn from exactly what a
+    copy with every update up to the robot's previous observation holds, and the robot waits far less often.
     """
 
     model: Callable[[], str]
@@ -158,21 +169,27 @@ class RobotActing:
     seed: Callable[[], int] = lambda: 0
     updates: Callable[[], list[str]] = list
     max_lag: int = 4
+    wait: str = "all"
+    fixed: Callable[[], bool] = lambda: False
 
     def __post_init__(self) -> None:
         if self.explore not in EXPLORE_KINDS:
             raise ValueError(f"explore must be one of {EXPLORE_KINDS}, got {self.explore!r}")
+        if self.wait not in WAIT_KINDS:
+            raise ValueError(f"wait must be one of {WAIT_KINDS}, got {self.wait!r}")
         if not 1 <= self.max_lag <= 1000:
             raise ValueError(f"max_lag must be in [1, 1000], got {self.max_lag}")
 
     def hello_lines(self) -> list[str]:
-        """``acting EXPLORE PARAM SEED MAX_LAG`` and the policy file's lines."""
+        """``acting EXPLORE PARAM SEED MAX_LAG WAIT FIXED`` and the policy file's lines."""
         param = float(self.param())
         if not (param > 0 if self.explore == "boltzmann" else 0 <= param <= 1) or not math.isfinite(param):
             raise ValueError(f"exploration parameter must be finite and a temperature > 0 (boltzmann) or a "
                              f"threshold in [0, 1], got {param} for {self.explore}")
         seed = int(self.seed()) & ((1 << 63) - 1)
-        return [f"acting {self.explore} {param!r} {seed} {self.max_lag}", *self.model().splitlines()]
+        fixed = int(bool(self.fixed()))
+        return [f"acting {self.explore} {param!r} {seed} {self.max_lag} {self.wait} {fixed}",
+                *self.model().splitlines()]
 
 
 @dataclass(frozen=True)
@@ -291,12 +308,14 @@ def parse_observation(line: str, hello: dict[str, Any], acting: bool = False) ->
     head = parts[0].split(" ")
     if len(parts) != 4 + acting or head[0] != "O" or len(head) != _OBS_FIELDS:
         raise ValueError(f"bad observation line: {line[:80]!r}")
-    action, behind = -1, 0
+    action, behind, ahead = -1, 0, 0
     if acting:
         move = parts[4].split(";")
-        action, behind = int(move[0]), int(move[-1])
-        if len(move) != 2 or not 0 <= action < 4 or not 0 <= behind <= 1000:
-            raise ValueError(f"bad move field {parts[4][:40]!r}: MOVE (0-3);BEHIND (0-1000)")
+        if len(move) != 3:
+            raise ValueError(f"bad move field {parts[4][:40]!r}: MOVE;BEHIND;AHEAD")
+        action, behind, ahead = int(move[0]), int(move[1]), int(move[2])
+        if not 0 <= action < 4 or not 0 <= behind <= 1000 or not 0 <= ahead <= 1000 - behind:
+            raise ValueError(f"bad move field {parts[4][:40]!r}: MOVE (0-3);BEHIND;AHEAD (together 0-1000)")
     rnd, turn, others = int(head[1]), int(head[2]), int(head[11])
     if rnd != hello["round"] or turn < 0 or others < 0:
         raise ValueError(f"observation of round {rnd}, turn {turn}, others {others} on the connection of round "
@@ -321,6 +340,7 @@ def parse_observation(line: str, hello: dict[str, Any], acting: bool = False) ->
         gun_heading=gun, radar_heading=radar, velocity=vel, energy=energy, gun_heat=heat, others=others,
         distance_remaining=remaining, width=float(hello["width"]), height=float(hello["height"]),
         scans=tuple(scans), events=events, history=parse_history(parts[3]), action=action, behind=behind,
+        ahead=ahead,
     )
 
 
@@ -351,7 +371,7 @@ def format_observation(obs: Observation) -> str:
     history = "|".join(f"{h.time};{h.energy!r};{h.target};{h.target_previous!r};{h.target_energy!r}"
                        for h in obs.history)
     return ("O " + " ".join(repr(v) for v in head) + "\t" + scans + "\t" + json.dumps(list(obs.events)) + "\t"
-            + history + ("" if obs.action < 0 else f"\t{obs.action};{obs.behind}"))
+            + history + ("" if obs.action < 0 else f"\t{obs.action};{obs.behind};{obs.ahead}"))
 
 
 def format_action(turn: int, action: Action) -> str:
@@ -399,7 +419,9 @@ class BridgeStats:
     errors_dropped: int = 0
     resets: int = 0  # sessions the robot's side reset: the engine stops robot threads at a round's end
     rejected: dict[str, int] = field(default_factory=dict)
-    behind: int = 0  # acting robots: decisions taken while some of the robot's own observations were unacknowledged
+    behind: int = 0  # acting robots: decisions taken while some of the robot's own observations that count for the
+    # move (WAIT) were unacknowledged
+    ahead: int = 0  # acting robots, WAIT row: decisions taken without waiting for acknowledgements that did not count
     policy_s: float = 0.0  # time inside the policy
     handling_s: float = 0.0  # the server's own time per decision: parse, format, send (policy excluded)
     parse_s: float = 0.0  # of which parsing the observation
@@ -696,6 +718,7 @@ class BridgeServer:
                         t3 = time.perf_counter()
                     with self._lock:
                         self.stats.behind += obs.behind > 0
+                        self.stats.ahead += obs.ahead > 0
                         self.stats.parse_s += parsed - t0
                         self.stats.send_s += t3 - t25
                         self.stats.decisions += 1

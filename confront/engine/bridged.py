@@ -47,7 +47,9 @@ class BridgedRun:
     ``policy_us`` inside the policy, ``handling_us`` the server's own work (parse, format, send); per robot
     turn ``work_us_per_turn`` the robots' own time outside execute() (deciding, round trips included, and the
     controller); ``behind``: decisions that robots acting themselves took from a copy of the policy that still
-    lacked the update of their previous observation. Statistics of a round that a robot played in fallback are
+    lacked an update of their earlier observations that could change the move (``RobotActing.wait``);
+    ``ahead``: decisions they took without waiting for the acknowledgement of observations whose updates could
+    not change the move (``wait="row"``). Statistics of a round that a robot played in fallback are
     lost with its connection.
     """
 
@@ -62,7 +64,8 @@ class BridgedRun:
     work_us_per_turn: float = float("nan")
     policy_us: float = float("nan")
     handling_us: float = float("nan")
-    behind: int = 0  # acting robots: decisions taken before the robot's previous observation was acknowledged
+    behind: int = 0  # acting robots: decisions taken before an observation that counts was acknowledged
+    ahead: int = 0  # acting robots: decisions taken ahead of acknowledgements that could not change them
 
     @property
     def ok(self) -> bool:
@@ -114,4 +117,4 @@ def run_bridged_battle(
                       work_us_per_turn=st.work_us / st.robot_turns if st.robot_turns else nan,
                       policy_us=1e6 * st.policy_s / st.decisions if st.decisions else nan,
                       handling_us=1e6 * st.handling_s / st.decisions if st.decisions else nan,
-                      behind=st.behind)
+                      behind=st.behind, ahead=st.ahead)

@@ -138,13 +138,22 @@ class LearnerPolicy:
             return "\n".join(head + rows) + "\n"
 
         return RobotActing(model=model, explore=kind, param=self._param, max_lag=self.max_lag,
-                           seed=lambda: int(self.rng.integers(1 << 62)), updates=self._drain)
+                           seed=lambda: int(self.rng.integers(1 << 62)), updates=self._drain, wait="row",
+                           fixed=self._param_fixed)
 
-    def _param(self) -> float:
-        """The learner's exploration parameter now: the temperature (Boltzmann) or the exploitation threshold."""
+    def _param(self, step: int | None = None) -> float:
+        """The learner's exploration parameter now (or after ``step`` updates): the temperature (Boltzmann) or the
+        exploitation threshold."""
         explore = self._explore  # the learner's (frozen) parameters, made once by robot_acting
-        step = self.learner.step  # type: ignore[attr-defined]
+        assert explore is not None
+        if step is None:
+            step = self.learner.step  # type: ignore[attr-defined]
         return explore.temperature(step) if explore.kind == "boltzmann" else explore.threshold(step)
+
+    def _param_fixed(self) -> bool:
+        """No later update changes the robots' exploration parameter: it does not explore, or the schedule has
+        reached its limit (the annealed temperature or the decaying threshold are monotone in the step)."""
+        return not self.explore or self._param() == self._param(1 << 62)
 
     def _drain(self) -> list[str]:
         out, self._updates = self._updates, []
@@ -174,7 +183,7 @@ class LearnerPolicy:
                     self._text[1][s] = row  # the policy file of the next hello, kept current row by row
                     self._text_step += 1
                 if self.explore:
-                    self._updates.append(f"X {self._param()!r}")
+                    self._updates.append(f"X {self._param()!r} {int(self._param_fixed())}")
 
     def __call__(self, obs: Observation) -> tuple[float, float, float, float, float]:
         """A decision turn: learn the step that ends here, pick the next move; gun, radar, fire are NaN (the

@@ -46,7 +46,9 @@ def test_hello_reply_carries_the_robots_own_policy() -> None:
     n = len(controller_lines(ctl))
     assert lines[0] == f"OK 2 10 0 1 {n} 3"  # M = 3: the acting line and the two lines of the policy file
     assert lines[1:n + 1] == controller_lines(ctl)
-    assert lines[n + 1:] == ["acting boltzmann 0.5 7 3", "confront-policy 1", "kind qtable"]
+    assert lines[n + 1:] == ["acting boltzmann 0.5 7 3 all 0", "confront-policy 1", "kind qtable"]
+    row = replace(settings.acting, wait="row", fixed=lambda: True)  # a learner's robots: see RobotActing
+    assert row.hello_lines()[0] == "acting boltzmann 0.5 7 3 row 1"
     assert BridgeSettings(10, ctl).hello_reply().splitlines()[0] == f"OK 2 10 0 0 {n}"  # unchanged without
 
 
@@ -59,6 +61,8 @@ def test_acting_settings_are_checked() -> None:
         _acting(explore="softmax")
     with pytest.raises(ValueError, match="max_lag"):
         _acting(max_lag=0)
+    with pytest.raises(ValueError, match="wait"):
+        _acting(wait="rows")
     with pytest.raises(ValueError, match="finite"):
         _acting(param=lambda: float("nan")).hello_lines()
     with pytest.raises(ValueError, match="temperature"):
@@ -71,15 +75,16 @@ def test_acting_settings_are_checked() -> None:
 
 def test_observation_with_the_move_taken() -> None:
     hello = parse_hello(json.dumps(HELLO), "t0k")
-    obs = parse_observation(OBS + "\t2;1", hello, acting=True)
-    assert (obs.action, obs.behind, obs.turn) == (2, 1, 11)
+    obs = parse_observation(OBS + "\t2;1;3", hello, acting=True)
+    assert (obs.action, obs.behind, obs.ahead, obs.turn) == (2, 1, 3, 11)
     assert parse_observation(format_observation(obs), hello, acting=True) == obs
     assert parse_observation(OBS, hello).action == -1  # Python decides
-    for bad in ("\t4;0", "\t-1;0", "\t2", "\t2;-1", "\t2;0;0", "\tx;0", ""):
+    for bad in ("\t4;0;0", "\t-1;0;0", "\t2", "\t2;0", "\t2;-1;0", "\t2;0;-1", "\t2;600;401", "\t2;0;0;0",
+                "\tx;0;0", ""):
         with pytest.raises(ValueError):
             parse_observation(OBS + bad, hello, acting=True)
     with pytest.raises(ValueError):
-        parse_observation(OBS + "\t2;0", hello)  # a move where an answer is expected
+        parse_observation(OBS + "\t2;0;0", hello)  # a move where an answer is expected
 
 
 def _read(sock: socket.socket, n: int, buf: bytearray) -> list[str]:
@@ -119,16 +124,16 @@ def test_updates_reach_every_acting_robot_and_a_silent_one_is_cut_off() -> None:
         for s, name in ((a, "A"), (b, "B")):
             s.sendall((json.dumps({**HELLO, "name": name}) + "\n").encode())
             assert _read(s, n, bufs[s])[0].startswith("OK 2 10 0 0 ")
-        a.sendall((OBS + "\t1;0\n").encode())
+        a.sendall((OBS + "\t1;0;0\n").encode())
         assert _read(a, 3, bufs[a]) == ["Q 5 1.0 2.0 3.0 4.0", "X 0.25", "K 11"]
         assert _read(b, 2, bufs[b]) == ["Q 5 1.0 2.0 3.0 4.0", "X 0.25"]  # B's copy too, without an ack
-        b.sendall((OBS.replace("O 0 11", "O 0 21") + "\t3;0\n").encode())
+        b.sendall((OBS.replace("O 0 11", "O 0 21") + "\t3;0;0\n").encode())
         assert _read(b, 3, bufs[b]) == ["Q 5 1.0 2.0 3.0 4.0", "X 0.25", "K 21"]
         assert _read(a, 2, bufs[a]) == ["Q 5 1.0 2.0 3.0 4.0", "X 0.25"]
         # from now on B never reads: 2000 update lines per observation of A fill its buffers, and it is cut off
         turn = 31
         while not server.stats.errors and turn < 3000:
-            a.sendall((OBS.replace("O 0 11", f"O 0 {turn}") + "\t0;0\n").encode())
+            a.sendall((OBS.replace("O 0 11", f"O 0 {turn}") + "\t0;0;0\n").encode())
             lines = _read(a, 2001, bufs[a])  # A reads its updates and the ack
             assert lines[-1] == f"K {turn}" and len(lines) == 2001
             turn += 10
@@ -176,7 +181,8 @@ def test_acting_robot_plays_the_exported_robots_battle(install, tmp_path) -> Non
 @pytest.mark.engine
 def test_learner_copy_in_the_robot_is_current(install) -> None:
     """max_lag = 1: each move is a greedy move of the learner's table as it was before the step that ends at
-    that decision was learned (the robot waited for every earlier update)."""
+    that decision was learned (the robot waited for every earlier update of the row it draws from), also when
+    Python is slower than the robots' decisions and the robots go on without waiting for the other rows."""
     learner = TabularQ()
     pol = LearnerPolicy(learner, np.random.default_rng(3), train=True, explore=False, step_turns=5, max_lag=1)
     twin = ExportedPolicy("qtable", q=np.zeros((320, 4)))
@@ -186,6 +192,7 @@ def test_learner_copy_in_the_robot_is_current(install) -> None:
         def __call__(self, obs: Observation) -> tuple[float, ...]:
             row = learner.q[twin.state_and_features(obs)[0]]
             checks.append(obs.behind == 0 and row[obs.action] == row.max())
+            time.sleep(0.003)  # slower than a decision every 5 turns: the robot runs ahead where it may
             return pol(obs)
 
         def end_episode(self, robot: str, round_: int, history=()) -> None:  # noqa: ANN001
@@ -198,7 +205,7 @@ def test_learner_copy_in_the_robot_is_current(install) -> None:
     assert res.ok, (res.failures, res.server_errors)
     assert len(checks) == pol.decisions == res.decisions > 50 and all(checks)
     assert pol.updates >= pol.decisions - 2 and learner.step == pol.updates
-    assert res.behind == 0
+    assert res.behind == 0 and 0 < res.ahead < res.decisions  # it went ahead, and it waited for its rows
     assert len({float(v) for v in learner.q.ravel()}) > 10  # the table moved away from its start
 
 

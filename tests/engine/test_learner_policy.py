@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from confront.arena.control import ControlConfig, move_commands
-from confront.arena.observe import reward_eq35, reward_eq35_scalar
+from confront.arena.observe import ObservationConfig, reward_eq35, reward_eq35_scalar
 from confront.engine.battle import BattleSpec
 from confront.engine.bridge import Observation, Scan, TurnEnergy
 from confront.engine.bridged import BRIDGE_BOT, run_bridged_battle
@@ -126,7 +126,7 @@ def test_acting_robots_learn_from_the_moves_taken_and_get_every_change() -> None
         else:
             row = " ".join(repr(float(v)) for v in learner.q[prev_state])
             temperature = learner.params.exploration_params().temperature(learner.step)
-            assert lines == [f"Q {prev_state} {row}", f"X {temperature!r}"]
+            assert lines == [f"Q {prev_state} {row}", f"X {temperature!r} 0"]  # 0: the temperature still falls
         prev_state = int(twin.learner_observation(obs, "discrete")[0])
         hist = (TurnEnergy(2 * k + 1, own, "e", enemy, enemy - 3),
                 TurnEnergy(2 * k + 2, own, "e", enemy - 3, enemy - 3))
@@ -136,6 +136,65 @@ def test_acting_robots_learn_from_the_moves_taken_and_get_every_change() -> None
     assert "\n".join(acting.hello_lines()[1:]) + "\n" == ExportedPolicy("qtable", q=np.ones((320, 4)),
                                                                          step_turns=2).to_text()
     assert LearnerPolicy(learner, np.random.default_rng(0), explore=False).robot_acting().explore == "greedy"
+
+
+def test_learners_robots_wait_only_for_updates_that_change_their_move() -> None:
+    """A learner's robots wait for the rows they draw from (WAIT row), and for every update while the exploration
+    parameter still changes: FIXED is 1 from the step where the annealed temperature has reached T_min exactly
+    (T_n = T_min + (T_max - T_min) eta^n: 0.01 + 0.09 * 0.9^n rounds to 0.01 from about n = 380 on)."""
+    learner = TabularQ()
+    pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2)
+    acting = pol.robot_acting()
+    assert acting is not None and acting.wait == "row" and acting.hello_lines()[0].endswith(" 1 row 0")
+    first = next(n for n in range(2000) if learner._explore.temperature(n) == 0.01)
+    assert 300 < first < 500 and learner._explore.temperature(first - 1) > 0.01
+    for step, fixed in ((first - 1, False), (first, True), (10**6, True)):
+        learner.step = step
+        assert pol._param_fixed() is fixed and acting.hello_lines()[0].endswith(f" 1 row {int(fixed)}")
+    learner.step = first - 1
+    hist = (TurnEnergy(0, 100.0, "", 0.0, 0.0),)
+    pol(replace(_obs(1, 100.0, 100.0, hist), action=0))
+    pol(replace(_obs(3, 97.0, 84.0, (TurnEnergy(1, 97.0, "e", 100.0, 100.0),)), action=1))
+    assert acting.updates()[-1] == "X 0.01 1"  # the update that reached T_min says so
+    greedy = LearnerPolicy(TabularQ(), np.random.default_rng(0), explore=False).robot_acting()
+    assert greedy is not None and greedy.hello_lines()[0].split()[-2:] == ["row", "1"]  # no parameter to wait for
+
+
+@pytest.mark.parametrize("mode", ["acting", "python"])
+def test_recorded_engine_stream_gives_the_table_of_the_code_before(mode: str) -> None:
+    """A real engine training run's stream (tests/fixtures/bridge) fed to the learner policy, parsed as the server
+    parses it: the same Q table bit for bit, steps, decisions and update lines as the code before the
+    one-transition path (issue 11: cheaper, the same learning)."""
+    import gzip
+    import json
+    from pathlib import Path
+
+    from confront.engine.bridge import parse_history, parse_observation
+    from confront.experiments.episodes import build_learner
+    from confront.experiments.spec import load_experiment
+
+    fixtures = Path(__file__).parents[1] / "fixtures" / "bridge"
+    cfg = load_experiment("demo", ["arena.scenario=1v1", "opponent.kind=SpinBot", "learner.kind=ssaq"])
+    obs_cfg = ObservationConfig(target=cfg.arena.target)
+    learner = build_learner(cfg, obs_cfg.n_features, 4)
+    pol = LearnerPolicy(learner, np.random.default_rng([cfg.train.seed, 0]), observation=obs_cfg,
+                        step_turns=cfg.arena.decision_turns, acting=mode == "acting")
+    acting = pol.robot_acting() if mode == "acting" else None
+    lines = 0
+    with gzip.open(fixtures / f"ssaq_1v1_spinbot_{mode}.txt.gz", "rt") as f:
+        for row in f:
+            head, rest = row.rstrip("\n").split("\t", 1)
+            who = json.loads(head)
+            if who.get("end"):
+                pol.end_episode(who["robot"], who["round"], parse_history(rest))
+            else:
+                hello = {"name": who["robot"], "team": "", "round": who["round"], "width": 800.0, "height": 600.0}
+                pol(parse_observation(rest, hello, acting=acting is not None))
+            lines += len(acting.updates()) if acting is not None else 0
+    expected = np.load(fixtures / f"ssaq_1v1_spinbot_{mode}.expected.npz")
+    assert learner.q.tobytes() == expected["q"].tobytes()
+    assert learner.step == pol.updates == int(expected["step"]) > 100
+    assert pol.decisions == int(expected["decisions"]) and lines == int(expected["update_lines"])
 
 
 def test_observation_without_history_is_refused() -> None:

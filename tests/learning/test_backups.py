@@ -65,5 +65,6 @@ def test_paper_target_one_is_smdp_target_bit_for_bit(t):
     for _ in range(200):
         r = rng.standard_t(3, (1, t)) * 5
         v = rng.normal() * 10
-        assert paper_target_one(r[0].tolist(), v, 0.9).hex() == float(smdp_target(r, np.array([v]), 0.9, "paper")[0]).hex()
+        want = float(smdp_target(r, np.array([v]), 0.9, "paper")[0])
+        assert paper_target_one(r[0].tolist(), v, 0.9).hex() == want.hex()
     assert paper_target_one([1.0, 2.0, 3.0], 4.0, 0.5) == 3.5  # the three-step example above

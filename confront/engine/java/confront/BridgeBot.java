@@ -10,6 +10,7 @@ import java.net.InetSocketAddress;
 import java.net.Socket;
 import java.util.SplittableRandom;
 import java.nio.charset.StandardCharsets;
+import java.util.ArrayDeque;
 import java.util.HashMap;
 import java.util.LinkedHashMap;
 import java.util.Map;
@@ -46,13 +47,19 @@ import robocode.util.Utils;
  * "CONFRONT bridge-failed REASON" for the runner to report. The "E" line carries the round's statistics:
  * decisions, their round-trip times, turns played and the robot's own work time outside execute().
  *
- * Acting mode (the hello reply's 7th field M > 0, followed by "acting EXPLORE PARAM SEED MAX_LAG" and a policy
- * file): the robot picks its moves itself from its own copy of the Q table (PolicyModel, as PolicyBot does,
- * with the learner's exploration: first maximum, random-tie greedy, Boltzmann or epsilon-greedy) and sends each
- * observation with "MOVE;BEHIND" appended, never waiting for an answer. Python acknowledges each observation
- * ("K TURN") and sends every change of the policy to every acting robot ("Q STATE V0 V1 V2 V3", "X PARAM"); the
- * robot reads them without blocking at its decision turns, and waits (at most its timeout) only when MAX_LAG
- * of its observations are unacknowledged. A closed connection or a bad line makes it fall back as above.
+ * Acting mode (the hello reply's 7th field M > 0, followed by "acting EXPLORE PARAM SEED MAX_LAG WAIT FIXED" and
+ * a policy file): the robot picks its moves itself from its own copy of the Q table (PolicyModel, as PolicyBot
+ * does, with the learner's exploration: first maximum, random-tie greedy, Boltzmann or epsilon-greedy) and sends
+ * each observation with "MOVE;BEHIND;AHEAD" appended (the unacknowledged observations that counted for the move and
+ * the others), never waiting for an answer. Python acknowledges each observation
+ * ("K TURN") and sends every change of the policy to every acting robot ("Q STATE V0 V1 V2 V3", "X PARAM FIXED");
+ * the robot reads them without blocking at its decision turns, and waits (at most its timeout) only when MAX_LAG
+ * of its observations are unacknowledged that count: with WAIT = "all" every one, with WAIT = "row" (a learner's
+ * robots) only those whose update could change the move it is about to draw, i.e. whose learned step starts at
+ * the state it decides in now (Python learns, at observation k, the step from the robot's decision k - 1), or any
+ * update while the exploration parameter may still change (FIXED 0). The others change rows this move does not
+ * read, so the move is the one a copy with every update would draw. At most 1000 observations stay
+ * unacknowledged. A closed connection or a bad line makes it fall back as above.
  */
 public class BridgeBot extends TeamRobot {
     static final int VERSION = 2;
@@ -74,8 +81,12 @@ public class BridgeBot extends TeamRobot {
     private double param;
     private SplittableRandom random;
     private int maxLag;
-    private long sent;
-    private long acked;
+    private boolean waitAll = true;  // WAIT "all": every unacknowledged observation counts; "row": see above
+    private boolean paramFixed;  // the exploration parameter no longer changes (FIXED 1)
+    private int lastState = -1;  // the state of this robot's previous decision in this round (-1: none yet)
+    // unacknowledged observations: turn, and the Q row Python learns when it takes them in (-1: none)
+    private final ArrayDeque<long[]> unacked = new ArrayDeque<>();
+    static final int MAX_UNACKED = 1000;
     // per turn since the last message: TIME;OWN_ENERGY;TARGET;TARGET_PREVIOUS_ENERGY;TARGET_ENERGY, joined by "|"
     private final StringBuilder history = new StringBuilder();
     private Map<String, Double> lastEnergies = new HashMap<>();
@@ -211,19 +222,23 @@ public class BridgeBot extends TeamRobot {
         return PolicyModel.read(new StringReader(text.append("matrix q 1 4\n0 0 0 0\n").toString()));
     }
 
-    /** The "acting EXPLORE PARAM SEED MAX_LAG" line and the policy file of the robot's own copy of the policy. */
+    /** The "acting EXPLORE PARAM SEED MAX_LAG WAIT FIXED" line and the policy file of the robot's own copy of the
+     *  policy. */
     private void actingModel(int m) throws IOException {
         String head = in.readLine();
         String[] p = head == null ? new String[0] : head.split(" ");
-        if (p.length != 5 || !p[0].equals("acting")
-                || !(p[1].equals("first") || p[1].equals("greedy") || p[1].equals("boltzmann") || p[1].equals("egreedy"))) {
+        if (p.length != 7 || !p[0].equals("acting")
+                || !(p[1].equals("first") || p[1].equals("greedy") || p[1].equals("boltzmann") || p[1].equals("egreedy"))
+                || !(p[5].equals("all") || p[5].equals("row")) || !(p[6].equals("0") || p[6].equals("1"))) {
             throw new IOException("bad acting line " + head);
         }
         explore = p[1];
         param = param(p[2]);
         random = new SplittableRandom(Long.parseLong(p[3]));
         maxLag = Integer.parseInt(p[4]);
-        if (maxLag < 1) {
+        waitAll = p[5].equals("all");
+        paramFixed = p[6].equals("1");
+        if (maxLag < 1 || maxLag > MAX_UNACKED) {
             throw new IOException("bad acting line " + head);
         }
         StringBuilder text = new StringBuilder();
@@ -258,18 +273,15 @@ public class BridgeBot extends TeamRobot {
     }
 
     /**
-     * A decision turn when acting: take the updates that arrived (waiting only when maxLag observations are
-     * unacknowledged), pick the move from the own copy of the policy, set it, and send the observation with it.
+     * A decision turn when acting: take the updates that arrived (waiting only when maxLag unacknowledged
+     * observations count for this move), pick the move from the own copy of the policy, set it, and send the
+     * observation with it.
      */
     private void actSelf(long turn) throws IOException {
         long t0 = System.nanoTime();
         while (in.ready()) {
             update(in.readLine());
         }
-        while (sent - acked >= maxLag) {
-            update(in.readLine());  // at most the socket's timeout, then the robot falls back
-        }
-        long waited = System.nanoTime() - t0;
         int n = enemies.size();
         double[] ex = new double[n];
         double[] ey = new double[n];
@@ -281,20 +293,40 @@ public class BridgeBot extends TeamRobot {
             ee[i] = v[2];
             i++;
         }
-        double[] v = acting.moveValues(getX(), getY(), getHeadingRadians(), getEnergy(), ex, ey, ee,
-                getBattleFieldWidth(), getBattleFieldHeight());
-        int a = choose(v);
+        int s = acting.moveState(getX(), getY(), getHeadingRadians(), ex, ey, getBattleFieldWidth(),
+                getBattleFieldHeight());
+        while (unacked.size() >= MAX_UNACKED || behind(s) >= maxLag) {
+            update(in.readLine());  // at most the socket's timeout, then the robot falls back
+        }
+        long waited = System.nanoTime() - t0;
+        int a = choose(acting.q[s]);  // PolicyModel.moveValues of a Q table: the row of state s
         double[] mv = acting.move(a);
         setAhead(mv[0]);
         setTurnRightRadians(mv[1]);
-        request(turn, a + ";" + (sent - acked));
-        sent++;
+        int counted = behind(s);
+        request(turn, a + ";" + counted + ";" + (unacked.size() - counted));
+        unacked.addLast(new long[] {turn, lastState});
+        lastState = s;
         long dt = waited + requestNanos;  // held up by Python: the wait for acknowledgements and the send
         rttN++;
         rttSum += dt;
         if (dt > 1000000) {
             rttSlow++;
         }
+    }
+
+    /** Unacknowledged observations that count for a move drawn in state s (WAIT above). */
+    private int behind(int s) {
+        if (waitAll) {
+            return unacked.size();
+        }
+        int k = 0;
+        for (long[] u : unacked) {
+            if (u[1] >= 0 && (u[1] == s || !paramFixed)) {
+                k++;  // its update changes row s, or may change the exploration parameter
+            }
+        }
+        return k;
     }
 
     /** One line from Python while acting: K (acknowledgement), Q (a Q-table row), X (exploration parameter). */
@@ -304,8 +336,10 @@ public class BridgeBot extends TeamRobot {
         }
         String[] p = line.split(" ");
         if (p[0].equals("K") && p.length == 2) {
-            Long.parseLong(p[1]);
-            acked++;
+            long[] u = unacked.pollFirst();
+            if (u == null || u[0] != Long.parseLong(p[1])) {
+                throw new IllegalArgumentException("acknowledgement '" + line + "' out of order");
+            }
         } else if (p[0].equals("Q") && p.length == 6) {
             int s = Integer.parseInt(p[1]);
             if (s < 0 || s >= acting.q.length) {
@@ -316,8 +350,9 @@ public class BridgeBot extends TeamRobot {
                 row[j] = finite(p[j + 2]);
             }
             acting.q[s] = row;
-        } else if (p[0].equals("X") && p.length == 2) {
+        } else if (p[0].equals("X") && p.length == 3 && (p[2].equals("0") || p[2].equals("1"))) {
             param = param(p[1]);
+            paramFixed = p[2].equals("1");
         } else {
             throw new IllegalArgumentException("bad update line '" + line + "'");
         }

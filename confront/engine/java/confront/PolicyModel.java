@@ -196,6 +196,15 @@ public final class PolicyModel {
         return h;
     }
 
+    /** The discrete state (0..319) for own position and heading and the enemies' last known positions: the row
+     *  of a Q table that {@link #moveValues} reads. */
+    public int moveState(double x, double y, double heading, double[] ex, double[] ey, double width, double height) {
+        if (!"nearest".equals(keys.get("target"))) {
+            throw new IllegalArgumentException("only target=nearest is exported");
+        }
+        return state(x, y, heading, nearest(x, y, ex, ey), ex, ey, maxDistance(width, height));
+    }
+
     /** The four move values for own state and the enemies' last known positions/energies. */
     public double[] moveValues(double x, double y, double heading, double energy, double[] ex, double[] ey,
                                double[] ee, double width, double height) {

@@ -10,10 +10,18 @@ from pathlib import Path
 from confront.engine.battle import scenario_battle, single_star
 from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, run_bridged_battle
 from confront.engine.export import ExportedPolicy, export_robot
-from confront.engine.runner import EngineOptions, run_battle
+from confront.engine.runner import EngineOptions, EngineRun, run_battle
 from confront.results import BattleResults
 
 MODES = ("export", "bridge")
+
+
+def exported_battle(robot: str | Path, scenario: str, opponents: str | Sequence[str], rounds: int,
+                    options: EngineOptions) -> EngineRun:
+    """The exported PolicyBot (``robot``: the folder or jar ``export_robot`` wrote) for our side of ``scenario``
+    against ``opponents``: the engine run (results, turns, round set-up time)."""
+    spec = single_star(scenario_battle(scenario, "confront.PolicyBot", opponents, rounds=rounds), "confront.PolicyBot*")
+    return run_battle(spec, options, extra_robots=[robot])
 
 
 def evaluate_policy(
@@ -43,9 +51,6 @@ def evaluate_policy(
         res = run_bridged_battle(spec, policy, opts, every=policy.step_turns, controller=policy.control).run.results
     else:
         with tempfile.TemporaryDirectory(prefix="confront-eval-") as tmp:
-            folder = export_robot(policy, Path(tmp) / "robots")
-            spec = single_star(scenario_battle(scenario, "confront.PolicyBot", opponents, rounds=rounds),
-                                "confront.PolicyBot*")
-            res = run_battle(spec, opts, extra_robots=[folder]).results
+            res = exported_battle(export_robot(policy, Path(tmp) / "robots"), scenario, opponents, rounds, opts).results
     ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))
     return res, res.score_ratio(ours.name)

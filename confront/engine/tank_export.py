@@ -26,6 +26,7 @@ import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
@@ -188,7 +189,7 @@ class TankPolicy:
     space: TankSpace = field(default_factory=TankSpace)
     control: ControlConfig = field(default_factory=ControlConfig)
     step_turns: int = 5
-    play: str = "greedy"
+    play: Literal["greedy", "sampled"] = "greedy"
 
     def __post_init__(self) -> None:
         if self.play not in PLAYS:
@@ -329,7 +330,7 @@ def is_tank_run(run: str | Path) -> bool:
     return isinstance(info, dict) and info.get("kind") == "ppo"
 
 
-def load_tank_policy(run: str | Path, play: str = "greedy") -> TankPolicy:
+def load_tank_policy(run: str | Path, play: Literal["greedy", "sampled"] = "greedy") -> TankPolicy:
     """The policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``, playing ``play``."""
     folder = _model_dir(run)
     cfg = json.loads((folder / "tank.json").read_text(encoding="utf-8"))
@@ -348,7 +349,7 @@ def load_tank_policy(run: str | Path, play: str = "greedy") -> TankPolicy:
     return replace(TankPolicy.from_state(state, space, control, int(step)), play=play)
 
 
-def export_tank_cli(run: str | Path, out: str | Path, play: str = "greedy") -> Path:
+def export_tank_cli(run: str | Path, out: str | Path, play: Literal["greedy", "sampled"] = "greedy") -> Path:
     """``confront export`` for a PPO run: write confront.TankBot (playing ``play``) and say where."""
     import click
 

@@ -6,15 +6,27 @@ import pytest
 
 from confront.engine.battle import BattleSpec
 from confront.engine.install import EngineInstall
-from confront.engine.runner import EngineOptions, run_battle
+from confront.engine.runner import EngineOptions, EngineRun, run_battle
 
 pytestmark = pytest.mark.engine
 
 
-def test_agent_removes_round_start_wait_and_keeps_the_battle(install: EngineInstall) -> None:
+def _pair(install: EngineInstall) -> tuple[EngineRun, EngineRun]:
     spec = BattleSpec(("SpinBot", "Walls", "Tracker", "RamFire"), rounds=6)
     fixed = run_battle(spec, EngineOptions(seed=1, cpu_constant_ms=10.0), install=install)
     plain = run_battle(spec, EngineOptions(seed=1, cpu_constant_ms=10.0, round_start_fix=False), install=install)
+    return fixed, plain
+
+
+def test_agent_removes_round_start_wait_and_keeps_the_battle(install: EngineInstall) -> None:
+    # a robot that overruns the 10 ms turn budget on a loaded machine skips a turn and plays another battle,
+    # so the pair is compared only when neither run skipped one (tried up to three times)
+    for _ in range(3):
+        fixed, plain = _pair(install)
+        skipped = sum(fixed.skipped_turns.values()) + sum(plain.skipped_turns.values())
+        if skipped == 0:
+            break
+    assert skipped == 0, f"every try skipped turns (loaded machine): {fixed.skipped_turns} {plain.skipped_turns}"
     # the plain engine loses a wake-up by chance (then 300 x 10 ms); with the agent never a full time-out
     assert fixed.setup_s < 1.5
     assert fixed.round_turns == plain.round_turns

@@ -127,11 +127,14 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
 @click.option("--opponents", default=None, help="Comma list of opponents (default: the run's).")
 @click.option("--rounds", type=COUNT, default=100, show_default=True)
 @click.option("--seed", type=SEED, default=0, show_default=True)
-def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: int) -> None:
-    """Play a trained policy greedily (simulator or real engine) and print its score table."""
+@click.option("--play", type=click.Choice(["sampled", "greedy"]), default=None,
+              help="PPO tanks: sample each action head (the default, as `confront export` plays) or take its "
+              "maximum. Paper policies always play greedily.")
+def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: int, play: str | None) -> None:
+    """Play a trained policy (simulator or real engine) and print its score table."""
     from confront.experiments.evaluate import evaluate_cli
 
-    evaluate_cli(run, engine=engine, opponents=opponents, rounds=rounds, seed=seed)
+    evaluate_cli(run, engine=engine, opponents=opponents, rounds=rounds, seed=seed, play=play)
 
 
 @cli.command()
@@ -186,19 +189,19 @@ def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: in
 @cli.command()
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Robots folder or .jar to write.")
-@click.option("--play", type=click.Choice(["greedy", "sampled"]), default="greedy", show_default=True,
-              help="PPO tanks: the first maximum of each action head, or a draw from its softmax (Robocode's "
-              "seeded random).")
-def export(run: Path, out: Path, play: str) -> None:
+@click.option("--play", type=click.Choice(["sampled", "greedy"]), default=None,
+              help="PPO tanks: draw each action head from its softmax, as it trained (Robocode's seeded random; "
+              "the default), or take the first maximum of each head.")
+def export(run: Path, out: Path, play: str | None) -> None:
     """Export a trained policy as a standalone Robocode robot (no Python needed to run it)."""
     from confront.engine.tank_export import export_tank_cli, is_tank_run
     from confront.experiments.evaluate import export_cli
 
     if is_tank_run(run):  # a PPO run over the tank view: confront.TankBot
-        export_tank_cli(run, out=out, play=play)
+        export_tank_cli(run, out=out, play=play or "sampled")
         return
-    if play != "greedy":
-        raise click.UsageError("--play sampled is for PPO tank runs (paper policies play their own rule)")
+    if play is not None:
+        raise click.UsageError("--play is for PPO tank runs (paper policies play their own rule)")
     export_cli(run, out=out, name=None)
 
 

@@ -349,7 +349,7 @@ def load_tank_policy(run: str | Path, play: Literal["greedy", "sampled"] = "gree
     return replace(TankPolicy.from_state(state, space, control, int(step)), play=play)
 
 
-def export_tank_cli(run: str | Path, out: str | Path, play: Literal["greedy", "sampled"] = "greedy") -> Path:
+def export_tank_cli(run: str | Path, out: str | Path, play: Literal["greedy", "sampled"] = "sampled") -> Path:
     """``confront export`` for a PPO run: write confront.TankBot (playing ``play``) and say where."""
     import click
 

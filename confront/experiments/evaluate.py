@@ -98,10 +98,11 @@ def sim_ratios(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: i
 
 
 def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int,
-                 sim_seeds: int = SIM_SEEDS) -> None:
-    """Score tables of the run's greedy policy per opponent, in the simulator (seed ``seed``, and the range
+                 sim_seeds: int = SIM_SEEDS, play: str | None = None) -> None:
+    """Score tables of the run's policy per opponent, in the simulator (seed ``seed``, and the range
     over ``sim_seeds`` runs with disjoint battle seeds from ``seed`` on) and with ``engine="robocode"`` in the
-    real engine."""
+    real engine. ``play``: PPO tanks sample their heads (``"sampled"``, the default) or take the maximum
+    (``"greedy"``); paper policies play greedily and take no ``play``."""
     if sim_seeds < 1:
         raise ValueError(f"sim_seeds must be >= 1, got {sim_seeds}")
     from confront.engine.tank_export import is_tank_run
@@ -109,12 +110,14 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     if is_tank_run(run):  # PPO tanks: per league entry (the engine: the exported TankBot)
         from confront.experiments.tanks import evaluate_tank_cli
 
-        evaluate_tank_cli(run, opponents, rounds, seed)
+        evaluate_tank_cli(run, opponents, rounds, seed, play=play or "sampled")
         if engine == "robocode":
             from confront.experiments.tanks import evaluate_tank_engine_cli
 
-            evaluate_tank_engine_cli(run, opponents, rounds, seed)
+            evaluate_tank_engine_cli(run, opponents, rounds, seed, play=play or "sampled")
         return
+    if play is not None:
+        raise click.UsageError("--play is for PPO tank runs (paper policies play greedily)")
     cfg = _run_config(run)
     learner, _ = load_model(run)
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}

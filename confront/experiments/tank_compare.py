@@ -117,10 +117,11 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
     return shares
 
 
-def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str, list[float]] | None = None
-            ) -> dict[str, Any]:
+def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str, list[float]] | None = None,
+            play: str = "greedy") -> dict[str, Any]:
     """Evaluate PPO tanks and every baseline method per seed and entry; write the report; return the results.
-    ``ours``: PPO tanks' shares per entry (one per run, in order) when already measured (tank_report's)."""
+    ``ours``: PPO tanks' shares per entry (one per run, in order) when already measured (tank_report's);
+    ``play``: how PPO tanks played them (``"greedy"`` or ``"sampled"``; the baselines play greedily)."""
     from confront.experiments.episodes import td_team
 
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
@@ -133,7 +134,7 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str
         _, td_path = td_team(cfg, 4)
         if ours is None:
             got_ours = evaluate_tanks(cfg, load_tank_model(run, cfg), rounds, seed=10_000 + cfg.train.seed,
-                                      opponents=tuple(entries))
+                                      opponents=tuple(entries), explore=play == "sampled")
         for e in entries:
             shares[OURS][e].append(ours[e][k] if ours is not None else got_ours[e]["share"])
         for m in METHODS:
@@ -147,7 +148,8 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str
             pc = paired_comparison(np.array(shares[OURS][e]), np.array(shares[m][e]), rng)
             tests[m][e] = {"diff": pc.diff.mean, "lo": pc.diff.lo, "hi": pc.diff.hi, "p": pc.p}
     result = {"runs": [r.name for r in runs], "seeds": seeds, "rounds": rounds, "train_rounds": TRAIN_ROUNDS,
-              "entries": entries, "shares": shares, "tests": tests}
+              "entries": entries, "shares": shares, "tests": tests, "play": play,
+              "ours_battle_seed": "10000" if ours is not None else "10000 + seed"}
     out.mkdir(parents=True, exist_ok=True)
     (out / "compare.json").write_text(json.dumps(result, indent=1))
     write_markdown(result, out)
@@ -209,10 +211,11 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
                "Cells: mean share over seeds; `vs X`: PPO tanks - X, mean [95% Welch interval], one-sided Welch t p "
                "(unpaired: the seed sets differ)."]
     else:
+        play = result.get("play", "greedy")
         how = [f"Training seeds {', '.join(map(str, seeds))} (one PPO tanks run each; the baselines trained "
                f"{result['train_rounds']} rounds against the same seed's TD team, as `confront reproduce "
-               f"baselines`). Simulator, greedy, {result['rounds']} rounds per entry and seed (battle seed 10000 + "
-               "seed).",
+               f"baselines`). Simulator, PPO tanks {play} (battle seed {result.get('ours_battle_seed', '10000 + seed')}"
+               f"), the baselines greedy (battle seed 10000 + seed), {result['rounds']} rounds per entry and seed.",
                f"Cells: mean share over the {n} seeds; `vs X`: PPO tanks - X, mean [95% BCa interval], one-sided "
                "paired sign-flip permutation p (the smallest possible p with n seeds is 2^-n)."]
     lines = [

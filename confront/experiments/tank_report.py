@@ -2,7 +2,7 @@
 (the exported TankBot, no Python) in the real engine, against the issue's targets.
 
     python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine [--unseen]
-        [--engine-runs K]] [--compare WORK] [--play greedy|sampled]
+        [--engine-runs K]] [--compare WORK] [--play sampled|greedy]
 
 Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
 (or with ``--play sampled`` the sampling) simulator share (``--rounds`` rounds, the mean over runs with a
@@ -186,7 +186,8 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
     if compare_work is not None:
         from confront.experiments.tank_compare import compare, compare_entries
 
-        compare(runs, out, rounds, compare_work, ours={e: sim[e] for e in compare_entries(tuple(entries))})
+        compare(runs, out, rounds, compare_work, ours={e: sim[e] for e in compare_entries(tuple(entries))},
+                play=play)
     (out / "results.json").write_text(json.dumps(result, indent=1))
     _curves(runs, out)
     write_markdown(result, out)
@@ -276,8 +277,9 @@ def main() -> None:
                     help="also compare with the paper's method, SB3 PPO and random moves (baselines cached in WORK)")
     ap.add_argument("--engine-from", type=Path, default=None, metavar="RESULTS_JSON",
                     help="take the engine rows from an earlier results.json of the same first run")
-    ap.add_argument("--play", choices=("greedy", "sampled"), default="greedy",
-                    help="the policy's actions in the simulator and the exported robot (default: greedy)")
+    ap.add_argument("--play", choices=("sampled", "greedy"), default="sampled",
+                    help="the policy's actions in the simulator and the exported robot: drawn from each head's "
+                         "softmax as `confront export` plays (default), or each head's maximum")
     args = ap.parse_args()
     if args.rounds < 1 or args.engine_seeds < 1 or not 1 <= args.engine_runs <= len(args.runs):
         ap.error("--rounds and --engine-seeds must be at least 1, --engine-runs between 1 and the number of runs")

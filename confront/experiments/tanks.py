@@ -494,8 +494,12 @@ def league_entries(opponents: str | None, cfg: ExperimentConfig) -> tuple[str, .
     return tuple(n if ":" in n else f"1v1:{n}" for n in names)
 
 
-def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int) -> dict[str, dict[str, float]]:
-    """Greedy shares of a PPO run per league entry in the simulator, printed as a table."""
+def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int, play: str = "sampled"
+                      ) -> dict[str, dict[str, float]]:
+    """Shares of a PPO run per league entry in the simulator, printed as a table; ``play``: ``"sampled"``
+    draws each head from its softmax, ``"greedy"`` takes its first maximum."""
+    if play not in ("sampled", "greedy"):
+        raise ValueError(f"play must be 'sampled' or 'greedy', got {play!r}")
     from dataclasses import replace
 
     from confront.experiments.spec import config_from_dict, load_toml
@@ -507,8 +511,8 @@ def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int) 
     except ValueError as exc:
         raise click.UsageError(str(exc)) from None
     ppo = load_tank_model(run, cfg)
-    res = evaluate_tanks(cfg, ppo, rounds, seed=seed)
-    click.echo(f"\n{run}: greedy policy, {rounds} rounds per opponent (simulator, seed {seed})\n")
+    res = evaluate_tanks(cfg, ppo, rounds, seed=seed, explore=play == "sampled")
+    click.echo(f"\n{run}: {play} policy, {rounds} rounds per opponent (simulator, seed {seed})\n")
     click.echo("| opponent | rounds | score share | win rate |\n|---|---:|---:|---:|")
     for name in entries:
         r = res[name]
@@ -517,17 +521,19 @@ def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int) 
 
 
 def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed: int,
-                             seeds: int = 1) -> dict[str, list[float]]:
-    """The exported TankBot (a jar, no Python) in the real engine against each scripted league entry, ``seeds``
-    battles of ``rounds`` rounds (engine seeds ``seed``, ``seed + 1``, ...): our score ratio per battle."""
+                             seeds: int = 1, play: str = "sampled") -> dict[str, list[float]]:
+    """The exported TankBot (a jar, no Python, playing ``play``) in the real engine against each scripted league
+    entry, ``seeds`` battles of ``rounds`` rounds (engine seeds ``seed``, ``seed + 1``, ...): our score ratio
+    per battle."""
     from confront.arena.bots import BOT_NAMES
     from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
     from confront.experiments.spec import config_from_dict, load_toml
 
     cfg = config_from_dict(load_toml(run / "config.toml"))
-    policy = load_tank_policy(run)
+    policy = load_tank_policy(run, play)  # type: ignore[arg-type]  # checked by load_tank_policy
     out: dict[str, list[float]] = {}
-    click.echo(f"\n{run}: the exported TankBot in Robocode, {rounds} rounds x {seeds} battle(s) per opponent\n")
+    click.echo(f"\n{run}: the exported TankBot ({play}) in Robocode, {rounds} rounds x {seeds} battle(s) per "
+               "opponent\n")
     click.echo("| opponent | battles | score ratio (robocode) |\n|---|---:|---:|")
     for entry in league_entries(opponents, cfg):
         scen, _, opp = entry.partition(":")

@@ -370,6 +370,11 @@ def test_exported_tank_robot_plays(install, tmp_path) -> None:
     res = CliRunner().invoke(cli, ["export", str(tmp_path / "run"), "--out", str(jar)])
     assert res.exit_code == 0, res.output
     assert "confront.TankBot" in res.output
+    assert "play sampled" in zipfile.ZipFile(jar).read("confront/tank_policy.txt").decode()  # the default
+    greedy = tmp_path / "greedy" / "tankbot.jar"
+    res = CliRunner().invoke(cli, ["export", str(tmp_path / "run"), "--out", str(greedy), "--play", "greedy"])
+    assert res.exit_code == 0, res.output
+    assert "play" not in zipfile.ZipFile(greedy).read("confront/tank_policy.txt").decode()
     names = set(zipfile.ZipFile(jar).namelist())
     assert {"confront/TankBot.class", "confront/TankModel.class", "confront/TankData.class",
             "confront/RoundStart.class", "confront/tank_policy.txt", "confront/TankBot.properties"} <= names

@@ -247,3 +247,20 @@ def test_paper_move_values_have_the_opponents_choices_as_maxima() -> None:
     assert (paper_move_values(cfg, "random") == 0).all()  # every move a maximum: uniform
     with pytest.raises(ValueError, match="paper-move"):
         paper_move_values(cfg, "SpinBot")
+
+
+def test_evaluate_cli_samples_by_default_and_plays_greedy_on_request(tmp_path) -> None:
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+    from confront.experiments.tanks import load_tank_model
+
+    cfg = _cfg(tmp_path, "1v1:SpinBot", **{"league.battles": "2", "train.rounds": "8"})
+    train_run(cfg, tmp_path / "run", progress=False)
+    ppo = load_tank_model(tmp_path / "run", cfg)
+    for args, explore in (([], True), (["--play", "greedy"], False)):
+        res = CliRunner().invoke(cli, ["evaluate", str(tmp_path / "run"), "--rounds", "6", "--seed", "3", *args])
+        assert res.exit_code == 0, res.output
+        assert ("sampled policy" if explore else "greedy policy") in res.output
+        want = evaluate_tanks(cfg, ppo, rounds=6, seed=3, explore=explore)["1v1:SpinBot"]
+        assert f"| 1v1:SpinBot | {want['rounds']} | {want['share']:.3f} | {want['win_rate']:.2f} |" in res.output

@@ -68,8 +68,9 @@ def compare_entries(opponents: tuple[str, ...]) -> list[str]:
     return out
 
 
-def _baseline_policy(method: str, seed: int, work: Path) -> tuple[Learner, ExperimentConfig]:
-    """The trained (or, for random moves, built) policy of ``method`` at ``seed``, and its experiment config."""
+def _baseline_policy(method: str, seed: int, work: Path, td_name: str) -> tuple[Learner, ExperimentConfig]:
+    """The trained (or, for random moves, built) policy of ``method`` at ``seed``, and its experiment config
+    (a trained DMNN is kept per TD-team artefact ``td_name``)."""
     from confront.experiments.episodes import load_model, smdp_config
     from confront.learning.uniform import UniformParams, UniformPolicy
 
@@ -78,7 +79,7 @@ def _baseline_policy(method: str, seed: int, work: Path) -> tuple[Learner, Exper
     if method == RANDOM_METHOD:
         return UniformPolicy(UniformParams(n_actions=smdp_config(exp).n_actions)), exp
     if method == DMNN_METHOD:
-        folder = work / "runs" / "dmnn-flm" / f"seed-{seed}"
+        folder = work / "runs" / "dmnn-flm" / td_name / f"seed-{seed}"
         run_jobs([Job("tank-compare", DMNN_METHOD, seed, bcfg.base,
                       bcfg.overrides + ('learner.learning_rate="fuzzy"',), folder)], TRAIN_ROUNDS, 1)
         learner, _ = load_model(folder)
@@ -98,13 +99,16 @@ def _baseline_policy(method: str, seed: int, work: Path) -> tuple[Learner, Exper
 
 def method_shares(method: str, seed: int, entries: list[str], td_model: str, rounds: int, work: Path
                   ) -> dict[str, float]:
-    """Greedy share per entry of a baseline method at ``seed`` (cached in ``work``)."""
+    """Greedy share per entry of a baseline method at ``seed`` (cached in ``work``, with the TD team it trained
+    against and faced: a cache made against another TD-team artefact is played again)."""
     done = work / "results" / f"{method.replace(' ', '_').replace('(', '').replace(')', '')}-seed-{seed}.json"
+    td_name = Path(td_model).name  # the artefact's digest folder (its config and seed), not this machine's path
     if done.exists():
         cached = json.loads(done.read_text())
-        if cached.get("rounds") == rounds and all(e in cached["shares"] for e in entries):
+        if (cached.get("rounds") == rounds and cached.get("td_team") == td_name
+                and all(e in cached["shares"] for e in entries)):
             return {e: cached["shares"][e] for e in entries}
-    policy, exp = _baseline_policy(method, seed, work)
+    policy, exp = _baseline_policy(method, seed, work, td_name)
     shares = {}
     for e in entries:
         scen, _, opp = e.partition(":")
@@ -112,8 +116,8 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
         rows = sim_evaluate(cfg, policy, opp, rounds, 10_000 + seed, td_model if opp == "td" else None)
         shares[e] = pooled_ratio(rows)[2]
     done.parent.mkdir(parents=True, exist_ok=True)
-    ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "shares": shares},
-                                     indent=1).encode())
+    ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "td_team": td_name,
+                                      "shares": shares}, indent=1).encode())
     return shares
 
 

@@ -264,3 +264,19 @@ def test_evaluate_cli_samples_by_default_and_plays_greedy_on_request(tmp_path) -
         assert ("sampled policy" if explore else "greedy policy") in res.output
         want = evaluate_tanks(cfg, ppo, rounds=6, seed=3, explore=explore)["1v1:SpinBot"]
         assert f"| 1v1:SpinBot | {want['rounds']} | {want['share']:.3f} | {want['win_rate']:.2f} |" in res.output
+
+
+def test_baseline_cache_is_kept_per_td_team(tmp_path) -> None:
+    from confront.experiments.baselines import RANDOM_METHOD
+    from confront.experiments.tank_compare import method_shares
+
+    entries = ["1v1:SittingDuck"]
+    played = method_shares(RANDOM_METHOD, 0, entries, "/a/td/aaaa", 2, tmp_path)["1v1:SittingDuck"]
+    cache = tmp_path / "results" / "Random_moves-seed-0.json"
+    got = json.loads(cache.read_text())
+    assert got["td_team"] == "aaaa" and got["shares"]["1v1:SittingDuck"] == played
+    cache.write_text(json.dumps({**got, "shares": {"1v1:SittingDuck": 0.123}}))
+    # the same artefact on another machine's path: the cache; another TD team: played again
+    assert method_shares(RANDOM_METHOD, 0, entries, "/b/td/aaaa", 2, tmp_path)["1v1:SittingDuck"] == 0.123
+    assert method_shares(RANDOM_METHOD, 0, entries, "/a/td/bbbb", 2, tmp_path)["1v1:SittingDuck"] == played
+    assert json.loads(cache.read_text())["td_team"] == "bbbb"

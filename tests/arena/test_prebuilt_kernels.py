@@ -87,6 +87,7 @@ def test_demo_loads_its_kernels_without_compiling(tmp_path: Path) -> None:
 def test_the_shipped_kernels_are_refused_when_they_do_not_match(monkeypatch: pytest.MonkeyPatch) -> None:
     if not PREBUILT.is_dir():
         pytest.skip(f"no shipped kernels for this platform and these versions ({kc.PREBUILT})")
+    usable = kc.prebuilt_dir()
     monkeypatch.setattr(kc, "TARGET_FEATURES", (*kc.TARGET_FEATURES, "no-such-feature"))  # a CPU without them
     kc.prebuilt_dir.cache_clear()
     assert kc.prebuilt_dir() is None
@@ -100,6 +101,11 @@ def test_the_shipped_kernels_are_refused_when_they_do_not_match(monkeypatch: pyt
     assert kc.prebuilt_dir() is None
     monkeypatch.undo()
     kc.prebuilt_dir.cache_clear()
+    monkeypatch.setattr(kc, "PREBUILT", kc.PREBUILT.replace(f"numba-{kc.numba.__version__}", "numba-0.0.0"))
+    assert kc.prebuilt_dir() is None  # another numba (or Python, or platform): no folder of that name
+    monkeypatch.undo()
+    kc.prebuilt_dir.cache_clear()
+    assert kc.prebuilt_dir() == usable
 
 
 RESULTS = textwrap.dedent("""

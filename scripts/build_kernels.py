@@ -31,7 +31,18 @@ def workload() -> None:
     """Run the usual entry points once; print the cache file bases of the kernels loaded from numba's cache (in
     the second run, with the cache the first one filled: the kernels Python calls, which hold their callees)."""
     import numpy as np
+    from numba.core import compiler
     from numba.core.dispatcher import Dispatcher
+
+    reduce = compiler.CompileResult._reduce
+
+    def reduce_without_listing(self: compiler.CompileResult) -> tuple:
+        """numba's cache entry without the typed-IR listing (``inspect_types``), which names this machine's paths
+        (source files, numpy's and Python's install folders); the code does not use it."""
+        out = reduce(self)
+        return (*out[:6], "", *out[7:])
+
+    compiler.CompileResult._reduce = reduce_without_listing
 
     from confront.arena import control
     from confront.arena.bots import ScriptedBots, bot_battle

@@ -39,6 +39,15 @@ def test_shipped_kernels_match_the_sources() -> None:
     assert meta["sources"] == kc.sources_digest(), "a kernel module changed: run python scripts/build_kernels.py"
 
 
+def test_shipped_kernels_name_no_paths_of_the_machine_that_built_them() -> None:
+    if not PREBUILT.is_dir():
+        pytest.skip(f"no shipped kernels for this platform and these versions ({kc.PREBUILT})")
+    for f in PREBUILT.iterdir():
+        data = f.read_bytes()
+        for part in (b"confront/arena/", b"site-packages", b"lib/python3", b"lib-dynload"):
+            assert part not in data, (f.name, part)
+
+
 SCRIPT = textwrap.dedent("""
     import json
     import numpy as np

@@ -7,7 +7,7 @@ Run it after changing a kernel module (``kernel_cache.KERNEL_MODULES``): the fil
 their sources, and ``tests/arena/test_prebuilt_kernels.py`` fails until it is rebuilt. It runs the
 workloads below twice in fresh processes (``NUMBA_CPU_NAME=x86-64-v3``, one empty ``NUMBA_CACHE_DIR``): the
 kernels the second run loads from the cache the first one filled (those Python calls, which hold their callees)
-are copied (a few CPU-minutes; about 3.6 MB). The vectorized ufuncs of observe.py are not among them: they
+are copied (a few CPU-minutes; about 3.1 MB). The vectorized ufuncs of observe.py are not among them: they
 compile at import (well under a second; their callees are shipped).
 
 Usage: python scripts/build_kernels.py

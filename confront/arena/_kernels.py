@@ -16,6 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .kernel_cache import install
 from .rules import (
     BULLET_RADIUS,
     GUN_TURN_RATE,
@@ -84,7 +85,7 @@ HALT_TURNS = 120  # robots halted when endTimer > 4 * TURNS_DISPLAYED_AFTER_ENDI
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def shuffle_into(rng: int, perm: np.ndarray, n: int, mode: int) -> int:
     """perm[:n] = 0..n-1, shuffled like Collections.shuffle when mode == 0 (swap(i-1, nextInt(i)))."""
     for i in range(n):
@@ -126,7 +127,7 @@ _REJECT = _reject_thresholds(_JUMP_N)
 _MASK48 = (1 << 48) - 1
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _skip_exact(rng: int, n: int) -> int:
     """skip_shuffle one step at a time, with nextInt's rejection loop."""
     for i in range(n, 1, -1):
@@ -139,7 +140,7 @@ def _skip_exact(rng: int, n: int) -> int:
     return rng
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def skip_shuffle(rng: int, n: int, mode: int) -> int:
     """Advance the generator exactly as shuffle_into(mode=0) would, without building the permutation.
 
@@ -161,7 +162,7 @@ def skip_shuffle(rng: int, n: int, mode: int) -> int:
     return (_JUMP_A[steps] * rng + _JUMP_C[steps]) & _MASK48
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _reset_inactivity(bi, bf, b, loss):
     """Battle.resetInactiveTurnCount: every 10 energy lost in total restarts the inactivity counter."""
     if loss < 0.0:
@@ -172,7 +173,7 @@ def _reset_inactivity(bi, bf, b, loss):
         bi[b, INACT] = 0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _set_energy(rf, bi, bf, b, i, new_e, reset_inactive):
     """RobotPeer.setEnergy: below 0.01 becomes 0 and clears movement and body turn."""
     if reset_inactive and rf[b, E, i] != new_e:
@@ -184,7 +185,7 @@ def _set_energy(rf, bi, bf, b, i, new_e, reset_inactive):
         rf[b, BODYREM, i] = 0.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _add_list_entry(kf, ki, bi, b, state, owner, x, y, power, heading, victim):
     """Append an entry to the battle's bullet list (first free slot); returns slot or -1 if full."""
     k = kf.shape[2]
@@ -217,7 +218,7 @@ def _add_list_entry(kf, ki, bi, b, state, owner, x, y, power, heading, victim):
     return slot
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i):
     """RobotPeer.kill: +10 to the inactivity ledger, leader's death costs team-mates 30, death explosion."""
     _reset_inactivity(bi, bf, b, 10.0)
@@ -228,16 +229,16 @@ def _kill(rf, rb, ri, bi, bf, kf, ki, dead, b, i):
             for j in range(n):
                 if j != i and rb[b, ALIVE, j] and ri[b, TEAM, j] == ri[b, TEAM, i]:
                     _set_energy(rf, bi, bf, b, j, rf[b, E, j] - 30.0, True)
-                    _add_list_entry(kf, ki, bi, b, B_HIT_VICTIM, i, rf[b, X, j], rf[b, Y, j], 4.0, 0.0, j)
+                    _add_list_entry(kf, ki, bi, b, np.int64(B_HIT_VICTIM), i, rf[b, X, j], rf[b, Y, j], 4.0, 0.0, j)
         cnt = dead[n]
         dead[cnt] = i
         dead[n] = cnt + 1
-        _add_list_entry(kf, ki, bi, b, B_EXPLODED, i, rf[b, X, i], rf[b, Y, i], 1.0, 0.0, i)
+        _add_list_entry(kf, ki, bi, b, np.int64(B_EXPLODED), i, rf[b, X, i], rf[b, Y, i], 1.0, 0.0, i)
     _set_energy(rf, bi, bf, b, i, 0.0, True)
     rb[b, ALIVE, i] = False
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _team_ledger(ri, ledger, b, killer, victim):
     """Damage the killer's whole team did to the victim this round (RobotStatistics.scoreBulletKill)."""
     tot = 0.0
@@ -247,7 +248,7 @@ def _team_ledger(ri, ledger, b, killer, victim):
     return tot
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _remove_from_list(ki, bi, b, pos):
     """Remove list entry at position pos (ArrayList.remove keeps the order); frees its slot."""
     n = bi[b, NB]
@@ -259,7 +260,7 @@ def _remove_from_list(ki, bi, b, pos):
     ki[b, KOWNER, slot] = -1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params, bb_decided):
     """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test."""
     mode = int(params[P_ORDER])
@@ -290,7 +291,7 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
         y = kf[b, KY, s]
         lx = kf[b, KLX, s]
         ly = kf[b, KLY, s]
-        owner = ki[b, KOWNER, s]
+        owner = np.int64(ki[b, KOWNER, s])
         # wall test with radius 3 (BulletPeer.checkWallCollision)
         if x - BULLET_RADIUS <= 0 or y - BULLET_RADIUS <= 0 or x + BULLET_RADIUS >= params[P_W] \
                 or y + BULLET_RADIUS >= params[P_H]:
@@ -383,7 +384,7 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
     ki[b, KSTATE, s] = st
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _turn_step(rem, rate):
     """This turn's share of a remaining turn: all of it, or ``rate`` toward it (RobotPeer.update*Heading)."""
     if rem > 0.0:
@@ -391,7 +392,7 @@ def _turn_step(rem, rate):
     return rem if rem > -rate else -rate
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _turn_body(rf, rb, b, i):
     """RobotPeer.updateHeading: at most min(maxTurnRate, 10 - 0.75|v|) deg; gun and radar follow."""
     rem = rf[b, BODYREM, i]
@@ -413,7 +414,7 @@ def _turn_body(rf, rb, b, i):
         rf[b, H, i] = normal_absolute_angle(rf[b, H, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _turn_gun(rf, rb, b, i):
     """RobotPeer.updateGunHeading: at most 20 deg; the radar follows (adjusted if adjustRadarForGun)."""
     rem = rf[b, GUNREM, i]
@@ -427,7 +428,7 @@ def _turn_gun(rf, rb, b, i):
     rf[b, GH, i] = normal_absolute_angle(rf[b, GH, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _turn_radar(rf, b, i):
     """RobotPeer.updateRadarHeading: at most 45 deg."""
     rem = rf[b, RADREM, i]
@@ -438,7 +439,7 @@ def _turn_radar(rf, b, i):
     rf[b, RH, i] = normal_absolute_angle(rf[b, RH, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _move(rf, rb, b, i):
     """RobotPeer.updateMovement: getNewVelocity, overdrive flag, remaining distance, position, box."""
     d = rf[b, DIST, i]
@@ -459,7 +460,7 @@ def _move(rf, rb, b, i):
         rf[b, BY, i] = rf[b, Y, i]
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple[bool, float, float, float]:
     """RobotPeer.checkWallCollision geometry: (hit, new x, new y, bearing of the wall)."""
     min_x = ROBOT_HALF
@@ -501,7 +502,7 @@ def wall_correction(x: float, y: float, h: float, w: float, hgt: float) -> tuple
     return True, x, y, ang
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, i, zap, params):
     """RobotPeer.performMove for robot i."""
     n = rf.shape[2]
@@ -591,7 +592,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             rf[b, BODYREM, i] = 0.0
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _add_hit_robot(rf, b, i, j, bearing, fault, energy):
     """One HitRobotEvent for robot i per collision, in the order they happen (RobotPeer.checkRobotCollision)."""
     k = int(rf[b, EVROBN, i])
@@ -603,7 +604,7 @@ def _add_hit_robot(rf, b, i, j, bearing, fault, energy):
         rf[b, EVROBN, i] = k + 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
     n = rf.shape[2]
@@ -636,7 +637,7 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
             if ext >= 0.0:
                 hit = sweep_hits_box_uv(x0, y0, ux, uy, vx, vy, ext != 0.0, RADAR_SCAN_RADIUS)
             else:
-                hit = sweep_hits_box_uv(x0, y0, vx, vy, ux, uy, True, RADAR_SCAN_RADIUS)
+                hit = sweep_hits_box_uv(x0, y0, vx, vy, ux, uy, ext != 0.0, RADAR_SCAN_RADIUS)  # True here
                 if not hit:
                     hit = segment_intersects_rect(0.0, 0.0, RADAR_SCAN_RADIUS * ux, RADAR_SCAN_RADIUS * uy,
                                                   x0, y0, 2 * ROBOT_HALF, 2 * ROBOT_HALF)
@@ -646,7 +647,7 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
     rb[b, TRWG, i] = (last[b, 0, i] == last[b, 1, i]) and (rf[b, GH, i] == rf[b, RH, i])
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _clear_events(b, i, rb, ri, scanned, rf):
     """Forget robot i's events and scans of the last turn (each turn starts with none)."""
     rf[b, EVROBN, i] = 0.0
@@ -662,7 +663,7 @@ def _clear_events(b, i, rb, ri, scanned, rf):
         scanned[b, i, j] = False
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                  placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order):
     """One Robocode turn of battle b (Battle.runTurn)."""
@@ -706,7 +707,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
             hd = rf[b, GH, i]
             if not rb[b, ADV, i] and rb[b, TRWG, i] and not math.isnan(assist):
                 hd = assist  # fire assist of plain Robots firing from onScannedRobot
-            if _add_list_entry(kf, ki, bi, b, B_FIRED, i, rf[b, X, i], rf[b, Y, i], p, hd, -1) >= 0:
+            if _add_list_entry(kf, ki, bi, b, np.int64(B_FIRED), i, rf[b, X, i], rf[b, Y, i], p, hd, np.int64(-1)) >= 0:
                 rb[b, EVFIRED, i] = True
     # 2. bullets in random order
     nb = bi[b, NB]
@@ -728,12 +729,12 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     for q in range(n):
         order[q] = perm_d[q]
     for q in range(n):
-        _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, order[q], zap, params)
+        _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, np.int64(order[q]), zap, params)
     bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
     for q in range(n):
         _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, q, mode)
     # 4. deaths: placements and +50 survival to every living robot of another team
-    nd = dead[n]
+    nd = np.int64(dead[n])
     bi[b, RNG] = skip_shuffle(bi[b, RNG], nd, mode)  # placements do not depend on this order
     for q in range(nd):
         d = dead[q]
@@ -836,7 +837,7 @@ def step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger
                  scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
 
 
-@njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                placements, placements_total, cmd, params, scratch_i, scratch_f):
     """Advance battles b0 .. b1-1 that are not done by one turn."""
@@ -849,7 +850,7 @@ def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledge
                        placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
                  params, fixed, has_fixed, scratch_i):
     """Start a new round in battle b (RobotPeer.initializeRound): placement, energies, gun heat 3."""
@@ -923,7 +924,7 @@ def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
     bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def reset_many(idx, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
                params, fixed, has_fixed, scratch_i):
     """reset_battle for every battle index in idx."""
@@ -932,10 +933,13 @@ def reset_many(idx, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
                      params, fixed, has_fixed, scratch_i)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _valid_spot(rf, b, i):
     """No overlap with any other robot's current box (RobotPeer.validSpot; NaN boxes never overlap)."""
     for j in range(rf.shape[2]):
         if j != i and boxes_intersect(rf[b, BX, i], rf[b, BY, i], rf[b, BX, j], rf[b, BY, j]):
             return False
     return True
+
+
+install(globals())

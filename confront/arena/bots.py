@@ -33,6 +33,7 @@ from numba import njit
 
 from . import _kernels as K
 from .core import Arena, _pool
+from .kernel_cache import install
 from .rules import normal_absolute_angle, normal_relative_angle
 from .scenarios import Scenario
 from .state import HIT_ROBOT_SLOTS
@@ -48,7 +49,7 @@ K_NONE, K_DUCK, K_SPIN, K_WALLS, K_TRACKER, K_RAMFIRE, K_FIRE, K_CORNERS, K_CRAZ
 
 # operation codes
 O_MOVE, O_TURN, O_GUN, O_RADAR, O_FIRE, O_SCAN, O_STOP, O_RESUME, O_SETMAXV, O_SETMOVE, O_SETTURN, \
-    O_WAITTURN, O_FIREASSIST, O_EXECUTE, O_SETRADAR, O_FIRECOOL = range(1, 17)
+    O_WAITTURN, O_FIREASSIST, O_EXECUTE, O_SETRADAR, O_FIRECOOL = np.arange(1, 17, dtype=np.int64)
 Q = 8  # operations per queue
 # memory layout (per robot)
 M_VAR = 0  # 8 bot variables
@@ -88,13 +89,13 @@ DEG = math.pi / 180.0  # == Math.toRadians(1) (java.lang.Math.DEGREES_TO_RADIANS
 RAD_TO_DEG = 57.29577951308232  # java.lang.Math.RADIANS_TO_DEGREES (Math.toDegrees)
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _deg(r):
     """Radians as the robot API reports degrees (ScannedRobotEvent.getBearing, Robot.getGunHeading: r*180/PI)."""
     return r * 180.0 / math.pi
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _heading_deg(h):
     """Robot.getHeading(): 180*h/PI, wrapped into [0, 360)."""
     d = 180.0 * h / math.pi
@@ -105,13 +106,13 @@ def _heading_deg(h):
     return d
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _rad(d):
     """Math.toRadians: the degree methods (turnRight, turnGunRight, ...) hand the peer d * DEGREES_TO_RADIANS."""
     return d * DEG
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _normal_relative_deg(a):
     """Utils.normalRelativeAngleDegrees: a % 360 into [-180, 180)."""
     a = np.fmod(a, 360.0)
@@ -120,7 +121,7 @@ def _normal_relative_deg(a):
     return a if a >= -180 else a + 360
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _level_of(prio):
     """Execution level of a handler priority."""
     for lv in range(1, N_LEVELS):
@@ -157,7 +158,7 @@ def bot_kind(name: str | None) -> int:
     return BOT_NAMES.index(name) + 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _top_level(mem, b, i):
     """The running execution level: the highest active handler, else run() (0)."""
     for lv in range(N_LEVELS - 1, 0, -1):
@@ -166,7 +167,7 @@ def _top_level(mem, b, i):
     return 0
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _push(mem, b, i, lv, op, val):
     """Append an operation to level lv's queue."""
     base = M_LV + lv * LV_SIZE
@@ -177,7 +178,7 @@ def _push(mem, b, i, lv, op, val):
         mem[b, i, base + LV_LEN] = n + 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _clear_level(mem, b, i, lv, active):
     base = M_LV + lv * LV_SIZE
     mem[b, i, base + LV_ACTIVE] = active
@@ -186,21 +187,21 @@ def _clear_level(mem, b, i, lv, active):
     mem[b, i, base + LV_START] = 0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _h(mem, b, i, op, val):
     """Append an operation to the handler being dispatched (the top level)."""
     _push(mem, b, i, _top_level(mem, b, i), op, val)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _m(mem, b, i, op, val):
-    _push(mem, b, i, 0, op, val)
+    _push(mem, b, i, np.int64(0), op, val)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _refill_main(kind, mem, b, i, heading, width, height, others):
     """Next pass of run(): the set-up part once per round, then the loop body."""
-    _clear_level(mem, b, i, 0, 1.0)
+    _clear_level(mem, b, i, np.int64(0), 1.0)
     first = mem[b, i, M_PHASE] == 0
     mem[b, i, M_PHASE] = 1
     if kind == K_SPIN:
@@ -272,7 +273,7 @@ def _refill_main(kind, mem, b, i, heading, width, height, others):
         _m(mem, b, i, O_EXECUTE, 0.0)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _marker(kind, mem, b, i, code):
     """Bookkeeping steps of run() written as pseudo-operations (negative SETMAXV values)."""
     if code == -1.0:
@@ -305,7 +306,7 @@ def _marker(kind, mem, b, i, code):
             mem[b, i, base + LV_START] = 0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _reverse(mem, b, i, cmd):
     """Crazy.reverseDirection: setBack/setAhead(40000)."""
     if mem[b, i, M_VAR + 4] == 1.0:
@@ -316,7 +317,7 @@ def _reverse(mem, b, i, cmd):
         mem[b, i, M_VAR + 4] = 1.0
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
     """A started operation is finished (blocking ops: remaining value 0)."""
     if not started:
@@ -334,7 +335,7 @@ def _op_done(op, started, rem_d, rem_b, rem_g, rem_r):
     return True
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, heading, rem, gun_eq_radar, heat, energy):
     """Write an operation's commands; True if it takes the turn (blocking)."""
     if op == O_EXECUTE:
@@ -401,7 +402,7 @@ def _issue(kind, mem, b, i, op, val, cmd, maxv, assist, scan_req, heading, rem, 
     return False
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _add_event(mem, b, i, prio, j, bearing, dist, energy, aux):
     """Queue an event of this turn (EventManager.add; a full queue drops it)."""
     n = int(mem[b, i, M_NEV])
@@ -419,7 +420,7 @@ def _add_event(mem, b, i, prio, j, bearing, dist, energy, aux):
     mem[b, i, M_NEV] = n + 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _remove_event(mem, b, i, k):
     n = int(mem[b, i, M_NEV])
     for m in range(k, n - 1):
@@ -428,7 +429,7 @@ def _remove_event(mem, b, i, k):
     mem[b, i, M_NEV] = n - 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _before(mem, b, i, k, m):
     """Event k sorts before event m (Event.compareTo: older first, then higher priority, then nearer scan /
     own-fault ram; equal ones keep their order)."""
@@ -447,7 +448,7 @@ def _before(mem, b, i, k, m):
     return mem[b, i, ek + E_SEQ] < mem[b, i, em + E_SEQ]
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
              ev_hitby, ev_hitby_bearing, hr, has_hr):
     """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns."""
@@ -459,20 +460,20 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
     else:
         j = ev_robot[b, i]
         if j >= 0:
-            _add_event(mem, b, i, P_ROBOT, j, ev_robot_bearing[b, i], 0.0, energy[b, j],
+            _add_event(mem, b, i, P_ROBOT, float(j), ev_robot_bearing[b, i], 0.0, energy[b, j],
                        1.0 if ev_fault[b, i] else 0.0)
     if ev_wall[b, i]:
-        _add_event(mem, b, i, P_WALL, -1, 0.0, 0.0, 0.0, 0.0)
+        _add_event(mem, b, i, P_WALL, -1.0, 0.0, 0.0, 0.0, 0.0)
     if ev_hitby[b, i] > 0:
         # the bullet's heading: back along the bearing it came from
-        _add_event(mem, b, i, P_BULLET, -1, ev_hitby_bearing[b, i], 0.0, 0.0,
+        _add_event(mem, b, i, P_BULLET, -1.0, ev_hitby_bearing[b, i], 0.0, 0.0,
                    ev_hitby_bearing[b, i] + h[b, i] - math.pi)
     for j2 in range(n):
         if scanned[b, i, j2] and alive[b, j2]:
             dx = x[b, j2] - x[b, i]
             dy = y[b, j2] - y[b, i]
             bearing = normal_relative_angle(math.atan2(dx, dy) - h[b, i])
-            _add_event(mem, b, i, P_SCAN, j2, bearing, math.hypot(dx, dy), energy[b, j2], 0.0)
+            _add_event(mem, b, i, P_SCAN, float(j2), bearing, math.hypot(dx, dy), energy[b, j2], 0.0)
     if mem[b, i, M_WON] == 0.0 and alive[b, i]:
         won = True
         for j2 in range(n):
@@ -480,9 +481,9 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
                 won = False
         if won:  # Battle.shutdownTurn: the survivors get a WinEvent in the turn the round is decided
             mem[b, i, M_WON] = 1.0
-            _add_event(mem, b, i, P_WIN, -1, 0.0, 0.0, 0.0, 0.0)
+            _add_event(mem, b, i, P_WIN, -1.0, 0.0, 0.0, 0.0, 0.0)
     old = mem[b, i, M_CLOCK] - MAX_EVENT_STACK
-    k = 0
+    k = np.int64(0)
     while k < int(mem[b, i, M_NEV]):
         if mem[b, i, M_EVQ + k * E_SIZE + E_TIME] <= old:
             _remove_event(mem, b, i, k)
@@ -490,7 +491,7 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
             k += 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _add_message(mem, b, d, time, px, py):
     """A team message (a Point) for robot d, delivered at ``time`` (sent in one turn, read in the next)."""
     n = int(mem[b, d, M_NEV])
@@ -508,7 +509,7 @@ def _add_message(mem, b, d, time, px, py):
     mem[b, d, M_NEV] = n + 1
 
 
-@njit(cache=True, inline="always", _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _head(mem, b, i):
     """Index of the first queued event in Robocode's order (-1: empty)."""
     best = np.int64(-1)  # not a literal -1: _dispatch(k) is then compiled once, for int64
@@ -520,7 +521,7 @@ def _head(mem, b, i):
     return best
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, cmd):
     """Start the handler of queued event k (removed from the queue): its level and operations."""
     e = M_EVQ + k * E_SIZE
@@ -655,7 +656,7 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
                 _h(mem, b, i, O_FIREASSIST, p)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
                  ev_hitby_bearing, ev_died, width, height, cmd, rem, hr, has_hr, heat):
@@ -750,7 +751,7 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
         mem[b, i, M_CLOCK] += 1
 
 
-@njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
               ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, heat):
@@ -765,7 +766,7 @@ def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_r
                      ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, heat)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _clear_memory(mem, b):
     """A new round: forget battle b's per-round bot memory (statics such as Corners' corner stay)."""
     for i in range(mem.shape[1]):
@@ -775,7 +776,7 @@ def _clear_memory(mem, b):
         mem[b, i, M_STOPPED] = 1.0  # the proxy starts each round as stopped: stop() saves nothing, resume() zeros
 
 
-@njit(cache=True, _nrt=False, error_model="numpy", nogil=True)
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger,
                score, score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, fixed,
                has_fixed, width, height, rem):
@@ -976,3 +977,6 @@ def bot_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 20
             if again.any():
                 arena.reset(again)
     return s.score_total.sum(axis=0), s.placements_total.sum(axis=0)
+
+
+install(globals())

@@ -36,6 +36,7 @@ from typing import Literal
 import numpy as np
 from numba import njit, vectorize
 
+from .kernel_cache import install
 from .tank import M_DROP, M_E, M_H, M_SEEN, M_TIME, M_TURN, M_V, MEMORY_ROWS
 
 N_REL_BINS = 4
@@ -94,6 +95,9 @@ def float_mod(a: float, m: float) -> float:
     if r < 0:
         r += m
     return r
+
+
+install(globals())  # before the vectorized ufuncs below compile float_mod at import
 
 
 @vectorize(["float64(float64)"], cache=True)
@@ -422,3 +426,6 @@ def observe(
                    kernel_array(seen, np.int32), sensing, TARGET_RULES[config.target], float(dmax), float(field[0]),
                    float(field[1]), target, disc, feats)
     return target, disc, feats
+
+
+install(globals())

@@ -12,6 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .kernel_cache import install
+
 __all__ = [
     "ACCELERATION", "DECELERATION", "MAX_VELOCITY", "MAX_TURN_RATE", "GUN_TURN_RATE", "RADAR_TURN_RATE",
     "RADAR_SCAN_RADIUS", "ROBOT_HALF", "BULLET_RADIUS", "ROBOT_HIT_DAMAGE", "ROBOT_HIT_BONUS",
@@ -37,7 +39,7 @@ NEAR_DELTA = 1e-5  # Utils.NEAR_DELTA
 TWO_PI = 2.0 * math.pi
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def normal_absolute_angle(a: float) -> float:
     """Angle in [0, 2pi) (Utils.normalAbsoluteAngle; Java's % on doubles is C fmod)."""
     if 0.0 <= a < TWO_PI:  # fmod leaves such values unchanged; skip the slow call
@@ -46,7 +48,7 @@ def normal_absolute_angle(a: float) -> float:
     return a if a >= 0.0 else a + TWO_PI
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def normal_relative_angle(a: float) -> float:
     """Angle in [-pi, pi) (Utils.normalRelativeAngle)."""
     if -math.pi <= a < math.pi:  # fmod leaves these unchanged and the result is a itself
@@ -57,13 +59,13 @@ def normal_relative_angle(a: float) -> float:
     return a if a >= -math.pi else a + TWO_PI
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def is_near(a: float, b: float) -> bool:
     """|a - b| < 1e-5 (Utils.isNear)."""
     return abs(a - b) < NEAR_DELTA
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def normal_near_absolute_angle(a: float) -> float:
     """normal_absolute_angle, snapped onto 0/90/180/270 deg when within 1e-5 (Utils.normalNearAbsoluteAngle)."""
     a = normal_absolute_angle(a)
@@ -82,7 +84,7 @@ def normal_near_absolute_angle(a: float) -> float:
     return a
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def max_velocity_for_distance(d: float) -> float:
     """Highest speed from which braking by 2/turn stops exactly after d (RobotPeer.getMaxVelocity)."""
     t = max(1.0, math.ceil((math.sqrt(4.0 * d + 1.0) - 1.0) / 2.0))  # decel time, quadratic formula
@@ -92,14 +94,14 @@ def max_velocity_for_distance(d: float) -> float:
     return (t - 1.0) * DECELERATION + (d - brake) / t
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def max_decel(speed: float) -> float:
     """Speed change when reversing: brake by 2, the rest of the turn accelerates by 1 (RobotPeer.maxDecel)."""
     decel_time = speed / DECELERATION
     return min(1.0, decel_time) * DECELERATION + max(0.0, 1.0 - decel_time) * ACCELERATION
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def new_velocity(v: float, d: float, max_v: float = MAX_VELOCITY) -> float:
     """Next velocity for remaining distance d (RobotPeer.getNewVelocity; mirrored for d < 0)."""
     sign = 1.0
@@ -116,7 +118,7 @@ def new_velocity(v: float, d: float, max_v: float = MAX_VELOCITY) -> float:
     return sign * max(v - ACCELERATION, min(goal, v + max_decel(-v)))
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def distance_until_stop(v: float) -> float:
     """Distance covered when braking from |v| to 0 (RobotPeer.getDistanceTraveledUntilStop)."""
     dist = 0.0
@@ -127,25 +129,25 @@ def distance_until_stop(v: float) -> float:
     return dist
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def turn_rate(v: float, max_rate: float = MAX_TURN_RATE) -> float:
     """Body turn limit min(maxTurnRate, (0.4 + 0.6(1 - |v|/8)) * 10 deg) = 10 - 0.75|v| deg (updateHeading)."""
     return min(max_rate, (0.4 + 0.6 * (1.0 - abs(v) / MAX_VELOCITY)) * MAX_TURN_RATE)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def clamp_power(p: float, energy: float) -> float:
     """Fire power clamped to [0.1, 3] and to the energy (RobotPeer.fireBullets)."""
     return min(energy, min(max(p, 0.1), 3.0))
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def bullet_speed(p: float) -> float:
     """20 - 3p (Rules.getBulletSpeed)."""
     return 20.0 - 3.0 * p
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def bullet_damage(p: float) -> float:
     """4p, plus 2(p - 1) above power 1 (Rules.getBulletDamage)."""
     d = 4.0 * p
@@ -154,25 +156,25 @@ def bullet_damage(p: float) -> float:
     return d
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def bullet_hit_bonus(p: float) -> float:
     """Energy returned to the shooter on a hit: 3p (Rules.getBulletHitBonus)."""
     return 3.0 * p
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def gun_heat(p: float) -> float:
     """Gun heat added by firing: 1 + p/5 (Rules.getGunHeat)."""
     return 1.0 + p / 5.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def wall_hit_damage(v: float) -> float:
     """max(|v|/2 - 1, 0) (Rules.getWallHitDamage)."""
     return max(abs(v) / 2.0 - 1.0, 0.0)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def segments_intersect(x1: float, y1: float, x2: float, y2: float,
                        x3: float, y3: float, x4: float, y4: float) -> bool:
     """Line-segment intersection as BulletPeer.intersect (parallel segments never meet: division by 0)."""
@@ -190,7 +192,7 @@ def segments_intersect(x1: float, y1: float, x2: float, y2: float,
     return 0.0 <= ua <= 1.0 and 0.0 <= ub <= 1.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _outcode(px: float, py: float, rx: float, ry: float, rw: float, rh: float) -> int:
     """Rectangle2D.outcode: bits left 1, top(low y) 2, right 4, bottom(high y) 8."""
     out = 0
@@ -205,7 +207,7 @@ def _outcode(px: float, py: float, rx: float, ry: float, rw: float, rh: float) -
     return out
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def segment_intersects_rect(x1: float, y1: float, x2: float, y2: float,
                             rx: float, ry: float, rw: float, rh: float) -> bool:
     """Closed segment vs closed rectangle (Rectangle2D.intersectsLine, Cohen-Sutherland style)."""
@@ -232,25 +234,25 @@ def segment_intersects_rect(x1: float, y1: float, x2: float, y2: float,
             y1 = y
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def segment_intersects_box(x1: float, y1: float, x2: float, y2: float, cx: float, cy: float) -> bool:
     """Bullet segment vs a robot's 36x36 box centred on (cx, cy) (BulletPeer.checkRobotCollision)."""
     return segment_intersects_rect(x1, y1, x2, y2, cx - ROBOT_HALF, cy - ROBOT_HALF, 2 * ROBOT_HALF, 2 * ROBOT_HALF)
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def boxes_intersect(ax: float, ay: float, bx: float, by: float) -> bool:
     """Two 36x36 boxes overlap with positive area (Rectangle2D.intersects is strict)."""
     return abs(ax - bx) < 2 * ROBOT_HALF and abs(ay - by) < 2 * ROBOT_HALF
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def box_contains(cx: float, cy: float, px: float, py: float) -> bool:
     """Point inside a 36x36 box, left/bottom edges included (Rectangle2D.contains)."""
     return cx - ROBOT_HALF <= px < cx + ROBOT_HALF and cy - ROBOT_HALF <= py < cy + ROBOT_HALF
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _in_wedge(px: float, py: float, ux: float, uy: float, vx: float, vy: float, r: float) -> bool:
     """Point (relative to the centre) within radius r, clockwise from direction u to v (angle <= pi)."""
     if px * px + py * py > r * r:
@@ -258,7 +260,7 @@ def _in_wedge(px: float, py: float, ux: float, uy: float, vx: float, vy: float, 
     return ux * py - uy * px <= 0.0 and vx * py - vy * px >= 0.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def sweep_hits_box_uv(x0: float, y0: float, ux: float, uy: float, vx: float, vy: float,
                       turned: bool, r: float) -> bool:
     """Pie test with the box's lower-left corner (x0, y0) relative to the centre and unit vectors.
@@ -308,7 +310,7 @@ def sweep_hits_box_uv(x0: float, y0: float, ux: float, uy: float, vx: float, vy:
     return False
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def sweep_hits_box(x: float, y: float, start: float, extent: float, cx: float, cy: float,
                    r: float = RADAR_SCAN_RADIUS) -> bool:
     """Radar pie from heading ``start`` over ``extent`` (signed, |extent| <= pi) of radius r hits a box.
@@ -335,13 +337,13 @@ _MULT = 0x5DEECE66D
 _MASK = (1 << 48) - 1
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def java_seed(seed: int) -> int:
     """Initial scrambled state of ``new java.util.Random(seed)``."""
     return (seed ^ _MULT) & _MASK
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def java_next(state: int, bits: int) -> tuple[int, int]:
     """java.util.Random.next(bits): (new state, value as a signed 32-bit int)."""
     state = (state * _MULT + 0xB) & _MASK
@@ -351,7 +353,7 @@ def java_next(state: int, bits: int) -> tuple[int, int]:
     return state, v
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def java_next_double(state: int) -> tuple[int, float]:
     """java.util.Random.nextDouble: ((next(26) << 27) + next(27)) * 2^-53."""
     state, a = java_next(state, 26)
@@ -359,7 +361,7 @@ def java_next_double(state: int) -> tuple[int, float]:
     return state, ((a << 27) + b) * (1.0 / (1 << 53))
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _mod31(u: int, bound: int) -> int:
     """u % bound for 0 <= u < 2^31 and 0 < bound < 2^31 without an integer division (exact)."""
     q = int(u * (1.0 / bound))  # off by at most one: 53-bit doubles, 31-bit operands
@@ -371,7 +373,7 @@ def _mod31(u: int, bound: int) -> int:
     return r
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def java_next_int(state: int, bound: int) -> tuple[int, int]:
     """java.util.Random.nextInt(bound) with its rejection rule."""
     state, r = java_next(state, 31)
@@ -384,3 +386,6 @@ def java_next_int(state: int, bound: int) -> tuple[int, int]:
         state, u = java_next(state, 31)
         r = _mod31(u, bound)
     return state, r
+
+
+install(globals())

@@ -48,7 +48,7 @@ from .core import Arena, run_parallel
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
 from .scenarios import Scenario, get_scenario
-from .smdp_kernel import _prepare, _relative, _smdp_turns, compile_callees_first, controller_turn  # noqa: F401 - re-exported
+from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # noqa: F401 - re-exported
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
 
@@ -173,7 +173,6 @@ class TeamBattleEnv:
         self.field = (float(self.scenario.width), float(self.scenario.height))
         self.max_distance = self.config.observation.max_distance or field_diagonal(*self.field)
         self._cmd = self.arena.idle_commands()
-        self._callees_compiled = False  # compile_callees_first done (once per env)
         self._powers = np.asarray(self.config.fire_powers, dtype=np.float64)
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._recording: tuple[Replay, int] | None = None
@@ -407,9 +406,6 @@ class TeamBattleEnv:
         ranges = [(0, self.n_battles)] if whole else self._ranges
         calls = [(lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
                  for k, (lo, hi) in enumerate(ranges)]
-        if not self._callees_compiled:
-            compile_callees_first(calls[0])
-            self._callees_compiled = True
         return calls
 
     def _run_turns(self, t0: int, t1: int, rewards: np.ndarray, obs: tuple[np.ndarray, ...]) -> int:

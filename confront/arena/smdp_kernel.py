@@ -3,51 +3,21 @@
 observations (``_smdp_turns``).
 
 A module of its own so that the Python side of the env (smdp.py) can change without recompiling the kernel;
-``_purge_stale_cache`` drops the numba cache of this module when a module the kernel calls into changed.
+its numba cache is stamped with all kernel modules' sources (kernel_cache.py), as it holds their code.
 """
 
 from __future__ import annotations
 
-import hashlib
-from pathlib import Path
-
 import numpy as np
-from numba import njit, typeof
+from numba import njit
 
 from . import _kernels as K
 from .bots import bots_step
+from .kernel_cache import install
 from .observe import float_mod, perceive_row, remember_scans, reward_eq35_scalar, robot_observation, target_of
 from .state import HIT_ROBOT_SLOTS
 from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
 
-
-def _purge_stale_cache() -> None:
-    """Drop this module's numba cache when a module its kernel calls into changed.
-
-    Numba's cache of ``_smdp_turns`` embeds the compiled turn kernel and bots of other modules but only
-    checks this file's time stamp; a stale copy would run old code (or crash) after they change.
-    """
-    here = Path(__file__).resolve()
-    cache = here.parent / "__pycache__"
-    deps = ("_kernels.py", "bots.py", "rules.py", "state.py", "observe.py", "tank.py", "smdp_kernel.py")
-    h = hashlib.sha256()
-    for name in deps:
-        f = here.parent / name
-        h.update(f.read_bytes() if f.is_file() else b"")
-    stamp = cache / "smdp_kernel.deps"
-    digest = h.hexdigest()
-    try:
-        if stamp.is_file() and stamp.read_text() == digest:
-            return
-        for f in cache.glob("smdp_kernel.*.nb[ic]"):
-            f.unlink(missing_ok=True)
-        cache.mkdir(exist_ok=True)
-        stamp.write_text(digest)
-    except OSError:  # read-only install: numba then caches elsewhere or not at all
-        pass
-
-
-_purge_stale_cache()
 C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = range(9)
 
 
@@ -132,24 +102,6 @@ def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, width, height, cmd, rem
               rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
               rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem,
               rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.HEAT])
-
-
-def compile_callees_first(args: tuple) -> None:
-    """Compile (or load from the cache) the turn kernel and the bots for ``_smdp_turns(*args)`` before it.
-
-    Numba compiles a callee inside the caller's compile otherwise, and there the same kernel took 2-3x the
-    CPU (``_step_battle`` 47 CPU-s nested, 19 on its own; measured in issue 10). Cheap once compiled or
-    cached: called once per env.
-    """
-    a = dict(zip(_smdp_turns.py_func.__code__.co_varnames, args, strict=False))
-
-    def types_of(names: str) -> tuple:
-        return tuple(typeof(a[n]) for n in names.split())
-
-    K.step_range.compile(types_of("b0 b1 rf rb ri bi bf bb kf ki scanned scan_time ledger score score_total "
-                                  "placements placements_total cmd params scratch_i scratch_f"))
-    if a["has_bots"]:
-        _bots_range.compile(types_of("b0 b1 kinds mem rf rb ri scanned width height cmd rem"))
 
 
 @njit(cache=True, nogil=True)
@@ -287,3 +239,6 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     view[b, i, :] = 0.0
                     slots[b, i, :] = -1
     return t1
+
+
+install(globals())

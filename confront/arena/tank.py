@@ -56,6 +56,8 @@ from typing import Literal
 import numpy as np
 from numba import njit
 
+from .kernel_cache import install
+
 __all__ = ["TankSpace", "MEMORY_ROWS", "n_features", "tank_view_row", "tank_view_kernel", "lead_point",
            "action_table", "FEATURE_NAMES"]
 
@@ -284,3 +286,6 @@ def tank_view_kernel(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray,
                           float(time[b]), width, height, k_slots, m_slots, mates[b], mates_ok[b], row, slots[b, i])
             for q in range(row.shape[0]):
                 feats[b, i, q] = row[q]
+
+
+install(globals())

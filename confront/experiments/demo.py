@@ -46,7 +46,7 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
         "\nNext:\n"
         f"  open {out}/plots/*.png                    the learning curves\n"
         f"  tensorboard --logdir {out}/tb             shares per opponent, losses, entropy, decisions/s\n"
-        f"  confront evaluate {out} --rounds 100      play the trained team greedily\n"
+        f"  confront evaluate {out} --rounds 100      play the trained team per opponent (score table)\n"
         f"  confront export {out} --out MyTank.jar    a Robocode robot that runs the policy without Python\n"
         "  confront train -c tanks                    the whole league (every sample robot, 1v1 and teams)\n"
         "  confront demo --paper                      the paper's fuzzy DMNN arm, for contrast\n"

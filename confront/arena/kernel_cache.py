@@ -11,8 +11,8 @@
   operations in the same order as the host's code: no fast-math, no fused multiply-add, so the same results bit
   for bit), read by numba's own cache reader. They are used when the sources' digest, numba, Python and the
   platform match the folder's and the CPU has the level's features; first use then loads the kernels instead of
-  compiling them (docs/arena.md, "First-use compile time"). ``CONFRONT_PREBUILT_KERNELS=0`` turns them off
-  (numba then compiles for this CPU and caches as usual).
+  compiling them (docs/arena.md, "First-use compile time"). ``CONFRONT_PREBUILT_KERNELS=0`` (or false, no,
+  off) turns them off (numba then compiles for this CPU and caches as usual).
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def sources_digest() -> str:
 def prebuilt_dir() -> Path | None:
     """The folder of shipped kernels if it can serve this process, else None (then numba compiles)."""
     path = HERE / "prebuilt" / PREBUILT
-    if os.environ.get(OFF_ENV, "1") == "0" or not path.is_dir():
+    if os.environ.get(OFF_ENV, "1").strip().lower() in ("0", "false", "no", "off") or not path.is_dir():
         return None
     from numba.core import config
     from numba.core.codegen import get_host_cpu_features

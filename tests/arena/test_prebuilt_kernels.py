@@ -101,9 +101,13 @@ def test_the_shipped_kernels_are_refused_when_they_do_not_match(monkeypatch: pyt
     kc.prebuilt_dir.cache_clear()
     assert kc.prebuilt_dir() is None
     monkeypatch.undo()
-    monkeypatch.setenv(kc.OFF_ENV, "0")
+    for off in ("0", "false", " Off "):
+        monkeypatch.setenv(kc.OFF_ENV, off)
+        kc.prebuilt_dir.cache_clear()
+        assert kc.prebuilt_dir() is None
+    monkeypatch.setenv(kc.OFF_ENV, "1")
     kc.prebuilt_dir.cache_clear()
-    assert kc.prebuilt_dir() is None
+    assert kc.prebuilt_dir() == usable
     monkeypatch.undo()
     kc.prebuilt_dir.cache_clear()
     monkeypatch.setattr(kc, "sources_digest", lambda: "0" * 64)  # a kernel module edited

@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -66,26 +67,29 @@ def mean_interval(values: list[float]) -> tuple[float, float, float]:
 
 
 def _curves(runs: list[Path], out: Path) -> list[Path]:
-    """Share per opponent against decisions and against wall time (200-round windows per opponent)."""
+    """Share per opponent against decisions and against wall time (windows of rounds per opponent) for the first
+    run that kept its per-round metrics (``metrics/rounds.csv``); none when no run did (a shipped model folder)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    run = next((r for r in runs if (r / "metrics" / "rounds.csv").is_file()), None)
+    if run is None:
+        print("note: no run has metrics/rounds.csv: the report has no learning curves", file=sys.stderr)
+        return []
+    rows = Run(run).read_table("rounds")
     figs = []
     for x_key, label in (("decisions", "agent decisions"), ("wall_s", "training wall time (s)")):
         fig, ax = plt.subplots(figsize=(9, 5))
-        for run in runs[:1]:
-            rows = Run(run).read_table("rounds")
-            for name in sorted({r["opponent"] for r in rows}):
-                sub = [r for r in rows if r["opponent"] == name]
-                windows = share_windows(sub, max(20, len(sub) // 30))
-                ax.plot([float(sub[end - 1][x_key]) for end, _ in windows], [v for _, v in windows], label=name,
-                        lw=1.2)
+        for name in sorted({r["opponent"] for r in rows}):
+            sub = [r for r in rows if r["opponent"] == name]
+            windows = share_windows(sub, max(20, len(sub) // 30))
+            ax.plot([float(sub[end - 1][x_key]) for end, _ in windows], [v for _, v in windows], label=name, lw=1.2)
         ax.axhline(0.5, color="k", ls=":", lw=0.8)
         ax.set_xlabel(label)
         ax.set_ylabel("score share (training, sampled actions)")
-        ax.set_title(f"PPO tanks: share per opponent against {label} (seed of {runs[0].name})")
+        ax.set_title(f"PPO tanks: share per opponent against {label} (seed of {run.name})")
         ax.legend(fontsize=6, ncol=3)
         path = out / f"share_vs_{x_key}.png"
         fig.tight_layout()

@@ -280,3 +280,20 @@ def test_baseline_cache_is_kept_per_td_team(tmp_path) -> None:
     assert method_shares(RANDOM_METHOD, 0, entries, "/b/td/aaaa", 2, tmp_path)["1v1:SittingDuck"] == 0.123
     assert method_shares(RANDOM_METHOD, 0, entries, "/a/td/bbbb", 2, tmp_path)["1v1:SittingDuck"] == played
     assert json.loads(cache.read_text())["td_team"] == "bbbb"
+
+
+def test_report_curves_come_from_the_first_run_with_round_metrics(tmp_path, capsys) -> None:
+    from confront.experiments.tank_report import _curves
+
+    shipped, trained = tmp_path / "shipped", tmp_path / "trained"
+    shipped.mkdir()  # a model folder as shipped: no metrics/rounds.csv
+    (trained / "metrics").mkdir(parents=True)
+    lines = ["opponent,decisions,wall_s,score_ours,score_theirs"]
+    lines += [f"1v1:SpinBot,{100 * k},{0.5 * k},{k},{100 - k}" for k in range(1, 61)]
+    (trained / "metrics" / "rounds.csv").write_text("\n".join(lines) + "\n")
+    assert _curves([shipped], tmp_path / "a") == []
+    assert "no learning curves" in capsys.readouterr().err
+    (tmp_path / "b").mkdir()
+    figs = _curves([shipped, trained], tmp_path / "b")
+    assert [f.name for f in figs] == ["share_vs_decisions.png", "share_vs_wall_s.png"]
+    assert all(f.stat().st_size > 1000 for f in figs)

@@ -44,7 +44,7 @@ def measure(opponents: list[str] | None, battles: int, updates: int, config: str
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--updates", type=int, default=5)
+    ap.add_argument("--updates", type=int, default=20, help="timed updates per row (5 swung by 20-30%%)")
     ap.add_argument("--battles", type=int, default=16)
     ap.add_argument("--threads", type=int, default=2, help="ppo.threads (the update's torch threads)")
     ap.add_argument("--precision", choices=("fp32", "bf16"), help="ppo.precision (default: each config's own)")

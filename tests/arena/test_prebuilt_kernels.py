@@ -48,7 +48,8 @@ def test_shipped_kernels_name_no_paths_of_the_machine_that_built_them() -> None:
             assert part not in data, (f.name, part)
 
 
-SCRIPT = textwrap.dedent("""
+# the arena kernels numba compiles in a subprocess (each script prints its result as the last line)
+COMPILES = textwrap.dedent("""
     import json
     import numpy as np
     from numba.core import event
@@ -65,6 +66,14 @@ SCRIPT = textwrap.dedent("""
             pass
 
     event.register("numba:compile", Compiles())
+""")
+
+def _last_line(script: str, env: dict[str, str]) -> object:
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+SCRIPT = COMPILES + textwrap.dedent("""
     from confront.arena.smdp import TeamBattleEnv
     from confront.experiments import tanks
     from confront.experiments.episodes import smdp_config
@@ -89,8 +98,7 @@ def test_demo_loads_its_kernels_without_compiling(tmp_path: Path) -> None:
         pytest.skip("the shipped kernels do not apply here (platform, numba / Python version, CPU, or sources)")
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
     env.pop(kc.OFF_ENV, None)
-    out = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, check=True).stdout
-    assert json.loads(out.strip().splitlines()[-1]) == []
+    assert _last_line(SCRIPT, env) == []
 
 
 def test_the_shipped_kernels_are_refused_when_they_do_not_match(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -121,24 +129,8 @@ def test_the_shipped_kernels_are_refused_when_they_do_not_match(monkeypatch: pyt
     assert kc.prebuilt_dir() == usable
 
 
-RESULTS = textwrap.dedent("""
+RESULTS = COMPILES + textwrap.dedent("""
     import hashlib
-    import json
-    import numpy as np
-    from numba.core import event
-
-    compiled = []
-
-    class Compiles(event.Listener):
-        def on_start(self, ev):
-            f = ev.data["dispatcher"].py_func
-            if f.__module__.startswith("confront.arena."):
-                compiled.append(f.__qualname__)
-
-        def on_end(self, ev):
-            pass
-
-    event.register("numba:compile", Compiles())
     from confront.arena import kernel_cache
     from confront.arena.bots import bot_battle
     from confront.arena.pool import PoolEntry, PoolEnv
@@ -172,8 +164,7 @@ RESULTS = textwrap.dedent("""
 
 
 def _results(env: dict[str, str]) -> dict:
-    out = subprocess.run([sys.executable, "-c", RESULTS], env=env, capture_output=True, text=True, check=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
+    return _last_line(RESULTS, env)  # type: ignore[return-value]
 
 
 def test_shipped_and_compiled_kernels_give_the_same_results(tmp_path: Path) -> None:

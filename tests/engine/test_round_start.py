@@ -12,7 +12,9 @@ pytestmark = pytest.mark.engine
 
 
 def _pair(install: EngineInstall) -> tuple[EngineRun, EngineRun]:
-    spec = BattleSpec(("SpinBot", "Walls", "Tracker", "RamFire"), rounds=6)
+    # a 1v1: the engine repeats seeded 1v1 battles of sample robots exactly, melees not always even without a
+    # skipped turn (robocode-facts.md §13; a melee pair here once differed in round 6, 1282 vs 1132 turns)
+    spec = BattleSpec(("Tracker", "RamFire"), rounds=6)
     fixed = run_battle(spec, EngineOptions(seed=1, cpu_constant_ms=10.0), install=install)
     plain = run_battle(spec, EngineOptions(seed=1, cpu_constant_ms=10.0, round_start_fix=False), install=install)
     return fixed, plain

@@ -1,8 +1,10 @@
 """PettingZoo ``ParallelEnv`` for a team: ``confront.parallel_env(scenario="4v4", opponents="SpinBot")``.
 
 Agents ``tank_0 .. tank_{n-1}`` are team 0's robots of one battle. Spaces, actions and rewards are those
-of :mod:`confront.arena.gym_env` per agent (Dict of discrete state and features; 4 moves or 4 x 3 with
-fire power; the sum of the T per-turn Eq. 35 rewards against each tank's own target). An agent
+of :mod:`confront.arena.gym_env` per agent: ``view="paper"`` (Dict of discrete state and features; 4 moves or
+4 x 3 with fire power; the sum of the T per-turn Eq. 35 rewards against each tank's own target) or ``"tank"``
+(the tank view Box(62), MultiDiscrete action heads, the team's score margin over the T turns: the same
+reward for every living team-mate). An agent
 terminates when its tank dies; an episode is one round (all agents end when the round is decided, or are
 truncated at ``max_turns``). ``infos[agent]``: the per-turn ``rewards`` (T,) and the tank's ``score``
 parts this round; at the round end also ``team_score`` (teams x 6). Opponents: a bot name, ``"td"``
@@ -18,11 +20,12 @@ from gymnasium import spaces
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from .gym_env import AgentDriver, OtherPolicy, make_config, make_observation_space
+from .gym_env import AgentDriver, OtherPolicy, action_indices, make_config, make_spaces
 from .render import draw_frame
 from .scenarios import Scenario, get_scenario
 from .smdp import SMDPConfig
 from .state import SCORE_PARTS
+from .tank import TankSpace
 
 __all__ = ["TeamParallelEnv", "parallel_env"]
 
@@ -32,35 +35,38 @@ class TeamParallelEnv(ParallelEnv):
 
     metadata = {"render_modes": ["rgb_array"], "name": "confront_team_v0", "is_parallelizable": True}
 
-    def __init__(self, scenario: Scenario | str = "4v4", opponents: Any = None, turns_per_step: int = 10,
+    def __init__(self, scenario: Scenario | str = "4v4", opponents: Any = None, turns_per_step: int | None = None,
                  fire_power_actions: bool = False, config: SMDPConfig | None = None,
                  other_policy: OtherPolicy | None = None, render_mode: str | None = None, seed: int = 0,
-                 order: str = "engine") -> None:
+                 order: str = "engine", view: str = "paper", tank: TankSpace | None = None,
+                 reward: str | None = None) -> None:
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         sc = get_scenario(scenario) if isinstance(scenario, str) else scenario
-        cfg = make_config(turns_per_step, fire_power_actions, config)
+        cfg = make_config(turns_per_step, fire_power_actions, config, view, tank, reward)
+        self.config = cfg
         n = sc.teams[0]
         self._driver = AgentDriver(sc, 1, seed, opponents, cfg, list(range(n)), other_policy, order)
         self.possible_agents = [f"tank_{i}" for i in range(n)]
         self.agents: list[str] = []
         self._index = {a: i for i, a in enumerate(self.possible_agents)}
-        self._obs_space = make_observation_space(cfg.observation.n_features)
-        self._act_space = spaces.Discrete(cfg.n_actions)
-        self._act_spaces = {a: spaces.Discrete(cfg.n_actions) for a in self.possible_agents}
+        self._obs_space, _ = make_spaces(cfg)
+        self._act_spaces = {a: make_spaces(cfg)[1] for a in self.possible_agents}
         self.render_mode = render_mode
         self._np_random, _ = seeding.np_random(seed)
         self._actions = np.zeros((1, n), dtype=np.int64)
 
     def observation_space(self, agent: str) -> spaces.Space:
-        """Dict(state=Discrete(320), features=Box(F,))."""
+        """Dict(state=Discrete(320), features=Box(F,)), or the tank view's Box(62,)."""
         return self._obs_space
 
     def action_space(self, agent: str) -> spaces.Space:
-        """Discrete(4) or Discrete(12)."""
+        """Discrete(4) or Discrete(12), or the tank actions' MultiDiscrete."""
         return self._act_spaces[agent]
 
-    def _obs(self, disc: np.ndarray, feats: np.ndarray, agents: list[str]) -> dict[str, dict[str, Any]]:
+    def _obs(self, disc: np.ndarray, feats: np.ndarray, agents: list[str]) -> dict[str, Any]:
+        if self.config.tank is not None:
+            return {a: feats[0, self._index[a]].copy() for a in agents}
         return {a: {"state": int(disc[0, self._index[a]]), "features": feats[0, self._index[a]].copy()}
                 for a in agents}
 
@@ -78,15 +84,16 @@ class TeamParallelEnv(ParallelEnv):
 
     def step(self, actions: dict[str, Any]) -> tuple[dict[str, Any], dict[str, float], dict[str, bool],
                                                      dict[str, bool], dict[str, Any]]:
-        """Hold every live agent's action for T turns (agents missing from ``actions`` move forward)."""
+        """Hold every live agent's action for T turns (agents missing from ``actions`` take action 0: forward,
+        or the first entry of every tank action head)."""
+        self._actions[:] = 0
         for a, v in actions.items():
             if a not in self._index:
                 raise ValueError(f"unknown agent {a!r}")
-            if not self._act_space.contains(v):
-                raise ValueError(f"action of {a} must be in 0..{self._act_space.n - 1}, got {v!r}")
-        self._actions[:] = 0
-        for a, v in actions.items():
-            self._actions[0, self._index[a]] = int(v)
+            try:
+                self._actions[0, self._index[a]] = action_indices(self.config, v, 1)[0]
+            except ValueError as err:
+                raise ValueError(f"action of {a}: {err}") from None
         drv = self._driver
         res = drv.env.step(drv.full_actions(self._actions, self._np_random))
         live = self.agents

@@ -113,7 +113,9 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
     """SB3 ``VecEnv`` over a TeamBattleEnv: one sub-environment per (battle, tank of team 0).
 
     Sub-environment ``k = b * n_ours + j`` is tank ``j`` of team 0 in battle ``b``. Observation: the
-    features vector; reward: Eq. 35 summed over the SMDP step's turns; done: the tank is dead or its round
+    features vector (with ``config.tank``: the tank view, actions as ``MultiDiscrete`` head indices,
+    ``gym_env.make_spaces``); reward: the config's (Eq. 35 or the score margin) summed over the SMDP step's
+    turns; done: the tank is dead or its round
     is over (``info["terminal_observation"]`` holds the last observation, ``"TimeLimit.truncated"`` marks
     a living tank whose round hit the turn limit). A tank dead at the start of a step is *padding* (it waits
     for its round to end): reward 0, done, ``info["padding"] = True``. The TD team, if any, acts greedily.
@@ -123,9 +125,7 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
                  td: Learner | None = None, config: SMDPConfig | None = None) -> None:
         if not HAVE_SB3:
             raise ImportError("SharedTeamVecEnv needs stable-baselines3: pip install 'confront[baselines]'")
-        from gymnasium import spaces
-
-        from confront.arena.gym_env import make_observation_space
+        from confront.arena.gym_env import make_spaces
 
         self.env = TeamBattleEnv(scenario, n_battles=n_battles, seed=seed, opponents=opponents, config=config)
         team = self.env.team_ids()
@@ -143,9 +143,9 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
         self._actions: np.ndarray | None = None
         self._disc = np.zeros((n_battles, self.env.n_robots), dtype=np.int64)
         self._feats = np.zeros((n_battles, self.env.n_robots, self.env.n_features), dtype=np.float32)
-        obs_space = make_observation_space(self.env.n_features)["features"]
+        obs_space, act_space = make_spaces(self.env.config)
         n = n_battles * self.ours.size
-        super().__init__(n, obs_space, spaces.Discrete(self.env.n_actions))
+        super().__init__(n, obs_space["features"] if self.env.config.tank is None else obs_space, act_space)
 
     def _flat(self, feats: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(feats[:, self.ours].reshape(self.num_envs, -1), dtype=np.float32)
@@ -158,11 +158,10 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
         return self._flat(self._feats)
 
     def step_async(self, actions: np.ndarray) -> None:
-        """Remember our tanks' actions, (N,) ints."""
-        a = np.asarray(actions).reshape(-1)
-        if a.size != self.num_envs:
-            raise ValueError(f"actions must have {self.num_envs} entries, got {a.size}")
-        self._actions = a.astype(np.int64)
+        """Remember our tanks' actions: (N,) ints, or (N, heads) with the tank view."""
+        from confront.arena.gym_env import action_indices
+
+        self._actions = action_indices(self.env.config, actions, self.num_envs)
 
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
         """One SMDP step of every battle: (obs, rewards, dones, infos) per sub-environment."""
@@ -176,7 +175,7 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
             full[:, self.theirs] = self.td.act(obs_t, self.rng, explore=False).reshape(b, -1)
         res = self.env.step(full)
         self._actions = None
-        rewards = res.rewards[:, self.ours].sum(axis=2).reshape(-1).astype(np.float32)  # Eq. 35 summed over T
+        rewards = res.rewards[:, self.ours].sum(axis=2).reshape(-1).astype(np.float32)  # summed over T
         active = res.active[:, self.ours]
         dones = (res.terminated[:, self.ours] | ~active).reshape(-1)
         terminal = res.features

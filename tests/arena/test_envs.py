@@ -125,3 +125,106 @@ def test_other_policy_drives_td_opponents() -> None:
     rem = team.arena.state.distance_remaining
     assert np.all(rem[:, 0] > 0) and np.all(rem[:, 1] < 0)
     assert team.arena.order == "fixed"
+
+
+# -- the tank view (view="tank"): what the recommended learner trains on, through the standard APIs ----------
+
+
+def test_tank_view_gym_spaces_values_and_score_margin_reward() -> None:
+    from confront.arena.tank import FEATURE_NAMES
+
+    env = gym.make("confront/Battle-v0", scenario="1v1", opponents="SpinBot", view="tank")
+    check_env(env.unwrapped, skip_render_check=True)
+    assert env.observation_space.shape == (62,) and env.observation_space.dtype == np.float32
+    assert list(env.action_space.nvec) == [5, 5, 4, 4, 2]
+    lo, hi = env.observation_space.low, env.observation_space.high
+    assert (lo[FEATURE_NAMES.index("velocity")], hi[FEATURE_NAMES.index("energy")]) == (-1.0, 10.0)
+    assert (lo[FEATURE_NAMES.index("enemy0_lateral")], lo[FEATURE_NAMES.index("enemy0_distance")]) == (-1.0, 0.0)
+    obs, _ = env.reset(seed=4)
+    s = env.unwrapped.team_env.arena.state
+    w, h = env.unwrapped.team_env.scenario.width, env.unwrapped.team_env.scenario.height
+    assert obs[0] == pytest.approx(s.x[0, 0] / w) and obs[3] == pytest.approx((h - s.y[0, 0]) / h)
+    assert obs[4] == pytest.approx(np.sin(s.heading[0, 0]), abs=1e-6) and obs[7] == pytest.approx(1.0)
+    assert obs[9] == 1.0 and obs[11] == 0.0  # the enemy lives, but no scan yet in a round's first turn
+
+    # a round's rewards add up to its score margin (ours minus theirs), also when the tank loses
+    for opp, action in (("SittingDuck", [4, 2, 3, 0, 1]), ("Tracker", [2, 2, 0, 0, 0])):
+        e = gym.make("confront/Battle-v0", scenario="1v1", opponents=opp, view="tank")
+        e.reset(seed=1)
+        total, done, info = 0.0, False, {}
+        while not done:
+            _, r, term, trunc, info = e.step(np.array(action))
+            total += r
+            done = term or trunc
+        team = info["team_score"].sum(axis=1)
+        assert total == pytest.approx(team[0] - team[1], abs=1e-9)
+        assert (total > 100) if opp == "SittingDuck" else (total < 0)  # holding fire against Tracker loses
+
+
+def test_tank_actions_decode_to_the_action_table_and_bad_ones_fail() -> None:
+    from confront.arena.gym_env import action_indices, make_config
+    from confront.arena.tank import LEADS, TankSpace, action_table
+
+    space = TankSpace()
+    cfg = make_config(view="tank")
+    assert cfg.turns_per_step == 5 and cfg.reward == "score" and cfg.observation.sensing == "scanned"
+    heads = np.array([[4, 0, 2, 3, 1], [0, 4, 0, 0, 0], [2, 2, 3, 1, 1]])
+    table = action_table(space)[action_indices(cfg, heads, 3)]
+    for (d, t, f, k, lead), row in zip(heads, table, strict=True):
+        power = space.fire_powers[f]
+        assert tuple(row) == (space.distances[d], np.radians(space.turns_deg[t]), power if power > 0 else -1.0,
+                              k, 1.0, LEADS[space.leads[lead]])
+    for bad in ([1, 2, 3], [5, 0, 0, 0, 0], [0, 0, 0, 0, -1], [0.5, 0, 0, 0, 0], 3, "a"):
+        with pytest.raises(ValueError, match="head indices"):
+            action_indices(cfg, bad, 1)
+    with pytest.raises(ValueError, match="view must be"):
+        make_config(view="scanned")
+    with pytest.raises(ValueError, match="view='tank'"):
+        make_config(tank=space)
+    with pytest.raises(ValueError, match="fire-power head"):
+        make_config(view="tank", fire_power_actions=True)
+
+
+def test_tank_view_vector_env_matches_single_env_and_restarts() -> None:
+    v = BattleVectorEnv(1, "1v1", "Walls", seed=9, view="tank")
+    e = gym.make("confront/Battle-v0", scenario="1v1", opponents="Walls", view="tank")
+    ov, _ = v.reset(seed=9)
+    oe, _ = e.reset(seed=9)
+    rng = np.random.default_rng(0)
+    for _ in range(12):
+        a = np.array([rng.integers(0, d) for d in (5, 5, 4, 4, 2)])
+        ov, rv, *_ = v.step(a[None])
+        oe, re, *_ = e.step(a)
+        assert np.array_equal(ov[0], oe) and rv[0] == re
+    v4 = BattleVectorEnv(4, "1v1", "SittingDuck", seed=2, view="tank")
+    obs, _ = v4.reset(seed=2)
+    assert obs.shape == (4, 62) and v4.action_space.shape == (4, 5)
+    for _ in range(300):
+        obs, r, term, trunc, info = v4.step(np.tile([4, 2, 3, 0, 1], (4, 1)))
+        if "final_obs" in info:
+            m = info["_final_obs"]
+            assert all(info["final_obs"][i].shape == (62,) for i in np.flatnonzero(m))
+            assert np.all(obs[m, 9] == 1.0) and np.all(obs[m, 11] == 0.0)  # a new round: nothing scanned yet
+            break
+    else:
+        raise AssertionError("no round against SittingDuck ended in 300 steps")
+
+
+def test_tank_view_pettingzoo_team_shares_the_score_margin() -> None:
+    parallel_api_test(parallel_env(scenario="4v4", opponents="SpinBot", view="tank"), num_cycles=60)
+    env = parallel_env(scenario="4v4", opponents="Walls", view="tank", seed=3)
+    obs, _ = env.reset(seed=3)
+    assert all(o.shape == (62,) for o in obs.values())
+    seen_nonzero = False
+    for _ in range(40):
+        acts = {a: env.action_space(a).sample() for a in env.agents}
+        obs, rew, term, trunc, _ = env.step(acts)
+        values = set(rew.values())
+        assert len(values) <= 1  # one team, one margin
+        seen_nonzero |= any(v != 0 for v in values)
+        if not env.agents:
+            break
+    assert seen_nonzero
+    with pytest.raises(ValueError, match="action of tank_0: a tank action"):
+        env.reset(seed=3)
+        env.step({"tank_0": 7})

@@ -110,6 +110,31 @@ def test_vec_env_matches_team_battle_env_on_fixed_actions() -> None:
 
 
 @sb3_only
+def test_vec_env_takes_the_tank_view_and_head_actions() -> None:
+    from confront.arena.gym_env import make_config
+    from confront.experiments.baselines import SharedTeamVecEnv
+
+    cfg = make_config(view="tank")
+    vec = SharedTeamVecEnv(SHORT, B, seed=5, opponents="SpinBot", config=cfg)
+    raw = TeamBattleEnv(SHORT, n_battles=B, seed=5, opponents="SpinBot", config=cfg)
+    ours = np.flatnonzero(raw.team_ids() == 0)
+    assert vec.observation_space.shape == (62,) and list(vec.action_space.nvec) == [5, 5, 4, 4, 2]
+    _, feats = raw.reset()
+    np.testing.assert_array_equal(vec.reset(), feats[:, ours].reshape(8, -1))
+    rng = np.random.default_rng(0)
+    for _ in range(8):
+        heads = np.stack([rng.integers(0, d, 8) for d in (5, 5, 4, 4, 2)], axis=1)
+        full = np.zeros((B, 8), dtype=np.int64)
+        full[:, ours] = np.ravel_multi_index(tuple(heads.T), (5, 5, 4, 4, 2)).reshape(B, 4)
+        res = raw.step(full)
+        obs, rewards, _, _ = vec.step(heads)
+        np.testing.assert_array_equal(obs, res.features[:, ours].reshape(8, -1))
+        np.testing.assert_allclose(rewards, res.rewards[:, ours].sum(axis=2).reshape(-1), rtol=1e-6)
+    with pytest.raises(ValueError, match="head indices"):
+        vec.step(np.zeros(8, dtype=np.int64))
+
+
+@sb3_only
 def test_vec_env_needs_the_td_learner() -> None:
     from confront.experiments.baselines import SharedTeamVecEnv
 

@@ -1,6 +1,8 @@
 """Throughput of the environments: Gymnasium step() calls/s, the vector env's and the SMDP team env's rates.
 
-Usage: ``python benchmarks/env_throughput.py [--seconds 2] [--json] [--pool-only]``. Prints a table; with
+Usage: ``python benchmarks/env_throughput.py [--seconds 2] [--json] [--pool-only]``. ``gym`` and ``vector`` rows
+are labelled with their view (``paper``: the paper's spaces; ``tank``: the tank view and head actions, T = 5;
+random actions from the action space). Prints a table; with
 ``--json`` the last line is a JSON list of records (``env``, ``scenario``, ``batch``, ``turns_per_step``,
 ``steps_per_s`` (step() calls), ``env_steps_per_s`` (battles x steps), ``turns_per_s``, ``robot_turns_per_s``,
 ``steps_per_cpu_s`` (step() calls per second of the process' CPU time: with threads above the wall rate,
@@ -48,33 +50,34 @@ def _rate(step: Callable[[int], None], seconds: float) -> float:
             return n / dt
 
 
-def bench_gym(scenario: str, opponents: str, turns: int, seconds: float) -> dict:
+def bench_gym(scenario: str, opponents: str, turns: int, seconds: float, view: str = "paper") -> dict:
     env = gym.make("confront/Battle-v0", scenario=scenario, opponents=opponents, turns_per_step=turns,
-                   disable_env_checker=True).unwrapped
+                   disable_env_checker=True, view=view).unwrapped
     env.reset(seed=0)
+    acts = [env.action_space.sample() for _ in range(64)]
 
     def step(i: int) -> None:
-        _, _, term, trunc, _ = env.step(i % 4)
+        _, _, term, trunc, _ = env.step(acts[i % 64])
         if term or trunc:
             env.reset()
 
     r = _rate(step, seconds)
     n = env.team_env.n_robots
-    return {"env": "gym", "scenario": scenario, "batch": 1, "turns_per_step": turns, "steps_per_s": r,
+    return {"env": f"gym/{view}", "scenario": scenario, "batch": 1, "turns_per_step": turns, "steps_per_s": r,
             "env_steps_per_s": r, "turns_per_s": r * turns, "robot_turns_per_s": r * turns * n}
 
 
-def bench_vector(scenario: str, opponents: str, batch: int, turns: int, seconds: float) -> dict:
-    env = BattleVectorEnv(batch, scenario, opponents, turns_per_step=turns, seed=0)
+def bench_vector(scenario: str, opponents: str, batch: int, turns: int, seconds: float, view: str = "paper") -> dict:
+    env = BattleVectorEnv(batch, scenario, opponents, turns_per_step=turns, seed=0, view=view)
     env.reset(seed=0)
-    acts = np.random.default_rng(0).integers(0, 4, size=(64, batch))
+    acts = [env.action_space.sample() for _ in range(64)]
 
     def step(i: int) -> None:
         env.step(acts[i % 64])
 
     r = _rate(step, seconds)
     n = env._driver.env.n_robots
-    return {"env": "vector", "scenario": scenario, "batch": batch, "turns_per_step": turns, "steps_per_s": r,
+    return {"env": f"vector/{view}", "scenario": scenario, "batch": batch, "turns_per_step": turns, "steps_per_s": r,
             "env_steps_per_s": r * batch, "turns_per_s": r * batch * turns,
             "robot_turns_per_s": r * batch * turns * n}
 
@@ -149,6 +152,9 @@ def main() -> None:
         bench_gym("4v4", "SpinBot", 10, s),
         bench_vector("1v1", "SpinBot", 64, 10, s),
         bench_vector("1v1", "SpinBot", 256, 10, s),
+        bench_gym("1v1", "SpinBot", 5, s, view="tank"),
+        bench_vector("1v1", "SpinBot", 256, 5, s, view="tank"),
+        bench_vector("4v4", "SpinBot", 64, 5, s, view="tank"),
         bench_team("4v4", "td", 1, 10, s),
         bench_team("4v4", "td", 64, 10, s),
         bench_team("4v4", "td", 256, 10, s),
@@ -160,12 +166,12 @@ def main() -> None:
     for r, cpu in zip(rows, CPU_RATES, strict=True):
         r["steps_per_cpu_s"] = cpu
     print(f"load average {os.getloadavg()[0]:.1f}; pool rows: batch = learning tanks, decisions/s = step()/s x batch")
-    head = f"{'env':<7}{'scenario':<11}{'batch':>6}{'T':>4}{'step()/s':>12}{'env-steps/s':>14}{'turns/s':>13}" \
+    head = f"{'env':<13}{'scenario':<11}{'batch':>6}{'T':>4}{'step()/s':>12}{'env-steps/s':>14}{'turns/s':>13}" \
            f"{'robot-turns/s':>16}{'step()/cpu-s':>14}"
     print(head)
     print("-" * len(head))
     for r in rows:
-        print(f"{r['env']:<7}{r['scenario']:<11}{r['batch']:>6}{r['turns_per_step']:>4}{r['steps_per_s']:>12,.0f}"
+        print(f"{r['env']:<13}{r['scenario']:<11}{r['batch']:>6}{r['turns_per_step']:>4}{r['steps_per_s']:>12,.0f}"
               f"{r['env_steps_per_s']:>14,.0f}{r['turns_per_s']:>13,.0f}{r['robot_turns_per_s']:>16,.0f}"
               f"{r['steps_per_cpu_s']:>14,.0f}")
     if args.json:

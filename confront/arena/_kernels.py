@@ -35,6 +35,7 @@ from .rules import (
     distance_until_stop,
     gun_heat,
     is_near,
+    java_atan2,
     java_next,
     java_next_double,
     java_next_int,
@@ -550,7 +551,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
             continue
         if not boxes_intersect(rf[b, BX, i], rf[b, BY, i], rf[b, BX, j], rf[b, BY, j]):
             continue
-        angle = math.atan2(rf[b, X, j] - rf[b, X, i], rf[b, Y, j] - rf[b, Y, i])
+        angle = java_atan2(rf[b, X, j] - rf[b, X, i], rf[b, Y, j] - rf[b, Y, i])  # Java's atan2
         v = rf[b, V, i]
         h = rf[b, H, i]
         bearing = normal_relative_angle(angle - h)

@@ -34,7 +34,7 @@ from numba import njit
 from . import _kernels as K
 from .core import Arena, _pool
 from .kernel_cache import install
-from .rules import normal_absolute_angle, normal_relative_angle
+from .rules import java_atan2, java_hypot, normal_absolute_angle, normal_relative_angle
 from .scenarios import Scenario
 from .state import HIT_ROBOT_SLOTS
 
@@ -472,8 +472,8 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
         if scanned[b, i, j2] and alive[b, j2]:
             dx = x[b, j2] - x[b, i]
             dy = y[b, j2] - y[b, i]
-            bearing = normal_relative_angle(math.atan2(dx, dy) - h[b, i])
-            _add_event(mem, b, i, P_SCAN, float(j2), bearing, math.hypot(dx, dy), energy[b, j2], 0.0)
+            bearing = normal_relative_angle(java_atan2(dx, dy) - h[b, i])  # Java's atan2 and hypot (fdlibm)
+            _add_event(mem, b, i, P_SCAN, float(j2), bearing, java_hypot(dx, dy), energy[b, j2], 0.0)
     if mem[b, i, M_WON] == 0.0 and alive[b, i]:
         won = True
         for j2 in range(n):
@@ -548,7 +548,7 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
             _h(mem, b, i, O_TURN, _rad(36000.0))
     elif prio == P_MESSAGE:
         if kind == K_DROID:  # onMessageReceived(Point): aim the gun at the point, fire(3)
-            theta = math.atan2(bearing - x[b, i], dist - y[b, i]) * RAD_TO_DEG
+            theta = java_atan2(bearing - x[b, i], dist - y[b, i]) * RAD_TO_DEG
             _h(mem, b, i, O_GUN, _rad(_normal_relative_deg(theta - _deg(gh[b, i]))))
             _h(mem, b, i, O_FIRE, 3.0)
     elif prio == P_ROBOT:

@@ -22,6 +22,7 @@ __all__ = [
     "bullet_speed", "bullet_damage", "bullet_hit_bonus", "gun_heat", "clamp_power", "wall_hit_damage",
     "segments_intersect", "segment_intersects_box", "boxes_intersect", "box_contains",
     "sweep_hits_box", "sweep_hits_box_uv", "java_seed", "java_next", "java_next_double", "java_next_int",
+    "java_atan2", "java_hypot",
 ]
 
 ACCELERATION = 1.0  # Rules.ACCELERATION
@@ -387,5 +388,157 @@ def java_next_int(state: int, bound: int) -> tuple[int, int]:
         r = _mod31(u, bound)
     return state, r
 
+
+# Java's Math.atan2 and Math.hypot are StrictMath's, i.e. fdlibm 5.3 (Java 17: FdLibm; HotSpot has no x86-64
+# intrinsic for either). fdlibm rounds differently from the C library in many cases: for robot-to-robot offsets
+# (|dx|, |dy| < 800) atan2 differs by an ulp in about 18% of calls and hypot in about 13% (measured against
+# Java 17 on 2 million pairs). Those ulps decide tests such as TrackFire's ``bearingFromGun == 0`` and how long
+# a robot's body turn of "0" takes, so the scan / collision bearings and scan distances use these two.
+# fdlibm's atan: argument reduced to [-7/16, 7/16] around 0, 1/2, 1, 3/2 or infinity (atan(c) split in a
+# high and a low part), then an odd polynomial of degree 23 in two halves (even / odd powers of x^4).
+_ATAN_HI = (4.63647609000806093515e-01, 7.85398163397448278999e-01, 9.82793723247329054082e-01,
+            1.57079632679489655800e+00)
+_ATAN_LO = (2.26987774529616870924e-17, 3.06161699786838301793e-17, 1.39033110312309984516e-17,
+            6.12323399573676603587e-17)
+_AT = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725034663711e-01,
+       -1.11111104054623557880e-01, 9.09088713343650656196e-02, -7.69187620504482999495e-02,
+       6.66107313738753120669e-02, -5.83357013379057348645e-02, 4.97687799461593236017e-02,
+       -3.65315727442169155270e-02, 1.62858201153657823623e-02)
+_PI_LO = 1.2246467991473531772e-16  # pi - (double) pi
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def _java_atan(x: float) -> float:
+    """StrictMath.atan (fdlibm s_atan)."""
+    ax = abs(x)
+    if ax != ax:
+        return x
+    if ax >= 7.378697629483821e19:  # 2^66
+        return math.copysign(_ATAN_HI[3] + _ATAN_LO[3], x)
+    k = -1
+    t = x
+    if ax >= 0.4375:
+        if ax < 0.6875:
+            k, t = 0, (2.0 * ax - 1.0) / (2.0 + ax)
+        elif ax < 1.1875:
+            k, t = 1, (ax - 1.0) / (ax + 1.0)
+        elif ax < 2.4375:
+            k, t = 2, (ax - 1.5) / (1.0 + 1.5 * ax)
+        else:
+            k, t = 3, -1.0 / ax
+    elif ax < 1.862645149230957e-09:  # 2^-29: atan(x) rounds to x
+        return x
+    z = t * t
+    w = z * z
+    s1 = z * (_AT[0] + w * (_AT[2] + w * (_AT[4] + w * (_AT[6] + w * (_AT[8] + w * _AT[10])))))
+    s2 = w * (_AT[1] + w * (_AT[3] + w * (_AT[5] + w * (_AT[7] + w * _AT[9]))))
+    if k < 0:
+        return t - t * (s1 + s2)
+    r = _ATAN_HI[k] - ((t * (s1 + s2) - _ATAN_LO[k]) - t)
+    return -r if x < 0.0 else r
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def _high_word(a: float) -> int:
+    """The upper 32 bits of the IEEE representation of a positive finite double."""
+    if a < 2.2250738585072014e-308:  # subnormal: the bits are a * 2^1074
+        return int(math.ldexp(a, 1042))
+    m, e = math.frexp(a)
+    return ((e + 1022) << 20) + int((2.0 * m - 1.0) * 1048576.0)
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def java_atan2(y: float, x: float) -> float:
+    """Math.atan2(y, x) bit for bit as Java computes it (fdlibm e_atan2)."""
+    if x != x or y != y:
+        return x + y
+    if x == 1.0:
+        return _java_atan(y)
+    yneg = math.copysign(1.0, y) < 0.0
+    xneg = math.copysign(1.0, x) < 0.0
+    if y == 0.0:
+        if not xneg:
+            return y
+        return -math.pi if yneg else math.pi
+    if x == 0.0:
+        return -math.pi / 2 if yneg else math.pi / 2
+    if math.isinf(x):
+        if math.isinf(y):
+            r = 0.75 * math.pi if xneg else 0.25 * math.pi
+        else:
+            r = math.pi if xneg else 0.0
+        return -r if yneg else r
+    if math.isinf(y):
+        return -math.pi / 2 if yneg else math.pi / 2
+    k = (_high_word(abs(y)) - _high_word(abs(x))) >> 20
+    if k > 60:
+        z = math.pi / 2 + 0.5 * _PI_LO
+    elif xneg and k < -60:
+        z = 0.0
+    else:
+        z = _java_atan(abs(y / x))
+    if not xneg:
+        return -z if yneg else z
+    return (z - _PI_LO) - math.pi if yneg else math.pi - (z - _PI_LO)
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def _from_high_word(hw: int) -> float:
+    """The positive double whose upper 32 bits are hw and lower 32 bits zero."""
+    if hw < 0x00100000:
+        return math.ldexp(float(hw), -1042)
+    return math.ldexp(1.0 + (hw & 0xFFFFF) / 1048576.0, (hw >> 20) - 1023)
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def java_hypot(x: float, y: float) -> float:
+    """Math.hypot(x, y) bit for bit as Java computes it (fdlibm e_hypot: the square root of a*a + b*b with
+    the squares split into exact upper and lower parts; the upper parts come from the high words, which the
+    scaling for tiny subnormal operands does not update)."""
+    a = abs(x)
+    b = abs(y)
+    if math.isinf(a) or math.isinf(b):
+        return math.inf
+    if a != a or b != b:
+        return a + b
+    if b > a:
+        a, b = b, a
+    if b == 0.0:
+        return a
+    ha = _high_word(a)
+    hb = _high_word(b)
+    if ha - hb > 0x3C00000:  # a / b > 2^60
+        return a + b
+    k = 0
+    if ha > 0x5F300000:  # a > 2^500: scale down by 2^600
+        ha -= 0x25800000
+        hb -= 0x25800000
+        a *= 2.0 ** -600
+        b *= 2.0 ** -600
+        k = 600
+    if hb < 0x20B00000:  # b < 2^-500
+        if hb <= 0x000FFFFF:  # subnormal b: scale by 2^1022, high words left as they were
+            a *= 2.0 ** 1022
+            b *= 2.0 ** 1022
+            k -= 1022
+        else:
+            ha += 0x25800000
+            hb += 0x25800000
+            a *= 2.0 ** 600
+            b *= 2.0 ** 600
+            k -= 600
+    w = a - b
+    if w > b:
+        t1 = _from_high_word(ha)
+        t2 = a - t1
+        w = math.sqrt(t1 * t1 - (b * (-b) - t2 * (a + t1)))
+    else:
+        a = a + a
+        y1 = _from_high_word(hb)
+        y2 = b - y1
+        t1 = _from_high_word(ha + 0x00100000)
+        t2 = a - t1
+        w = math.sqrt(t1 * y1 - (w * (-w) - (t1 * y2 + t2 * b)))
+    return math.ldexp(w, k) if k != 0 else w
 
 install(globals())

@@ -30,6 +30,7 @@ FIXES = {
     "sample_victory_dance": "the winner's onWin (Tracker's dance) in the turns after the end",
     "sample_trackfire": "sample.TrackFire (degrees, gun heat, its onWin spin)",
     "sample_myfirstteam": "sampleteam.MyFirstTeam: the leader's Point messages read by the droids a turn later",
+    "sample_trackfire_ramfire_team": "Java's atan2 (fdlibm) for scan bearings: TrackFire's bearingFromGun == 0 test",
 }
 
 

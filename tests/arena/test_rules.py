@@ -155,3 +155,51 @@ def test_next_int_rejection_and_skip_match_java():
     # (2^31 - 1) with bound 7 is rejected by Java: one extra draw is consumed
     s = _state_before((1 << 31) - 1)
     assert R.java_next_int(s, 7)[0] != R.java_next(s, 31)[0]
+
+
+# Math.atan2 / Math.hypot as OpenJDK 17 computes them (fdlibm), for offsets where the C library's result is an
+# ulp away; the first two atan2 rows are from the engine traces (TrackFire to RamFire, seed 1 turn 78; RamFire's
+# collision with TrackFire, seed 2 turn 93), the rest from random offsets within 800 px
+JAVA_ATAN2 = [
+    (422.66443889049833, -31.950009461253217, 1.6462447410837993),
+    (33.48562936708959, -5.91444090840173, 1.7456194755280456),
+    (-749.7308178774707, -227.32812883659417, -1.8651982127823132),
+    (585.0988741237636, -21.45494107808954, 1.6074488202547184),
+    (580.5186540764188, 315.349302340128, 1.073173442709703),
+    (27.680433662553483, 337.86816520536826, 0.08174416671189727),
+    (526.0963120559334, 513.4216169920269, 0.7975904177760161),
+    (311.29595908178516, -402.5047485745413, 2.4832848558742073),
+    (-576.6033238626322, 41.72474983267627, -1.4985592326786565),
+    (523.7556448269696, -25.85987660699054, 1.6201301982964447),
+]
+JAVA_HYPOT = [
+    (204.69324066155625, -58.56116635464783, 212.90545548986412),
+    (-109.90471178326224, -268.2811545844023, 289.9203745467053),
+    (141.61381903086382, 632.2276565710965, 647.8937285341528),
+    (-6.768960516071054, -518.6188768292512, 518.6630488381663),
+    (-382.971186225844, 18.176971923704777, 383.40231061842235),
+    (311.529070464009, -572.1507821782436, 651.4651788786148),
+    (-144.54686399665616, 613.0514457683528, 629.8617872596618),
+    (311.29595908178516, -402.5047485745413, 508.837151518738),
+]
+
+
+@pytest.mark.parametrize("y, x, java", JAVA_ATAN2)
+def test_atan2_is_javas_bit_for_bit(y, x, java):
+    assert R.java_atan2(y, x) == java
+
+
+@pytest.mark.parametrize("x, y, java", JAVA_HYPOT)
+def test_hypot_is_javas_bit_for_bit(x, y, java):
+    assert R.java_hypot(x, y) == java
+
+
+def test_atan2_and_hypot_special_values_as_java():
+    pi = math.pi
+    assert R.java_atan2(0.0, -1.0) == pi and R.java_atan2(-0.0, -1.0) == -pi
+    assert R.java_atan2(0.0, 1.0) == 0.0 and R.java_atan2(1.0, 0.0) == pi / 2 and R.java_atan2(-1.0, 0.0) == -pi / 2
+    assert R.java_atan2(math.inf, -math.inf) == 0.75 * pi and R.java_atan2(-1.0, math.inf) == 0.0
+    assert math.isnan(R.java_atan2(math.nan, 1.0)) and math.isnan(R.java_hypot(math.nan, 1.0))
+    assert R.java_hypot(math.inf, math.nan) == math.inf
+    assert R.java_hypot(3.0, 4.0) == 5.0 and R.java_hypot(0.0, -2.5) == 2.5
+    assert R.java_hypot(1e300, 1e300) == math.hypot(1e300, 1e300)  # scaled down (both agree here)

@@ -14,27 +14,28 @@ THEM4 = ["Walls", "Tracker", "Crazy", "Fire"]
 # with the simulator. melee4 and 4v4 re-recorded for issue 11 (rules that were wrong before, each shown by an
 # engine trace in tests/fixtures/traces/samples, tests/arena/test_bots_engine.py): one HitRobotEvent per
 # collision, disabled robots run on, a dying robot's last wake and the interruptible flag kept across rounds,
-# stop()/resume() at a round start, degree arithmetic, onWin. fire_corners is unchanged. (Before: the event
-# queue of commit 69360a4; before that commit 34b3372 used the newest event only.)
+# stop()/resume() at a round start, degree arithmetic, onWin; re-recorded again for Java's atan2 / hypot
+# (fdlibm, rules.java_atan2: scan and collision bearings, scan distances). fire_corners is unchanged. (Before:
+# the event queue of commit 69360a4; before that commit 34b3372 used the newest event only.)
 RECORDED = {
     "melee4": (OURS4, None, 3,
-               [[600.0, 0.0, 396.80000000000024, 22.120000000000047, 14.4, 0.0],
-                [900.0, 180.0, 371.39999999999975, 60.39999999999995, 3.5999999999999996, 0.0],
-                [250.0, 0.0, 787.600000000001, 86.80000000000001, 4.8, 0.0],
-                [50.0, 0.0, 531.6, 10.800000000000004, 103.19999999999997, 0.0]],
+               [[600.0, 0.0, 521.0000000000003, 24.56000000000007, 16.8, 0.0],
+                [900.0, 180.0, 448.79999999999944, 66.11999999999989, 8.399999999999999, 0.0],
+                [250.0, 0.0, 785.0000000000014, 69.00000000000001, 9.6, 0.0],
+                [50.0, 0.0, 435.6, 10.800000000000004, 88.79999999999997, 0.0]],
                [[0, 6, 0], [6, 0, 0], [0, 0, 5], [0, 0, 1]]),
     "fire_corners": (["Fire", "Corners"], None, 5,
                      [[300.0, 60.0, 623.0, 124.60000000000001, 0.0, 0.0], [0.0, 0.0, 392.0, 0.0, 0.0, 0.0]],
                      [[6, 0, 0], [0, 6, 0]]),
     "4v4": (OURS4 + THEM4, "4v4", 11,
-            [[800.0, 0.0, 309.0, 34.6, 23.999999999999993, 0.0],
-             [700.0, 0.0, 315.5999999999999, 84.84000000000003, 7.2, 0.0],
-             [550.0, 0.0, 663.0000000000002, 109.36000000000003, 14.399999999999999, 0.0],
-             [300.0, 0.0, 225.20000000000022, 0.0, 62.39999999999999, 13.320000000000002],
-             [1200.0, 240.0, 552.2000000000002, 74.48000000000003, 4.8, 0.0],
-             [400.0, 0.0, 447.60000000000025, 65.96000000000005, 6.0, 31.139999999999997],
-             [600.0, 40.0, 196.40000000000015, 10.4, 33.599999999999994, 0.0],
-             [250.0, 0.0, 330.8, 21.08000000000001, 2.4, 0.0]],
+            [[850.0, 0.0, 255.0, 15.8, 23.999999999999993, 0.0],
+             [700.0, 0.0, 325.5999999999999, 93.24000000000004, 7.2, 0.0],
+             [500.0, 0.0, 639.6000000000001, 85.96000000000001, 15.599999999999998, 0.0],
+             [300.0, 0.0, 209.20000000000022, 0.0, 52.8, 13.320000000000002],
+             [1200.0, 240.0, 553.6000000000001, 80.80000000000004, 2.4, 0.0],
+             [350.0, 0.0, 543.6000000000003, 65.96000000000005, 7.199999999999999, 31.139999999999997],
+             [600.0, 40.0, 156.40000000000015, 10.4, 29.999999999999993, 0.0],
+             [300.0, 0.0, 308.0, 0.0, 2.4, 0.0]],
             [[0, 1, 0], [0, 5, 0], [0, 0, 0], [0, 0, 0], [6, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]]),
 }
 
@@ -67,8 +68,8 @@ def _loop(arena: Arena, bots: ScriptedBots, turns: int) -> int:
     ("melee", ["Fire", "Corners", "Crazy", "Walls"], 2),
 ])
 def test_play_equals_the_step_loop(scenario, names, threads):
-    a = Arena(scenario, 6, seed=5, threads=threads)  # a seed whose 4v4 rounds end within the 1500 turns
-    b = Arena(scenario, 6, seed=5, threads=threads)
+    a = Arena(scenario, 6, seed=6, threads=threads)  # a seed whose 4v4 rounds end within the 1500 turns
+    b = Arena(scenario, 6, seed=6, threads=threads)
     bots_a, bots_b = ScriptedBots(a, names), ScriptedBots(b, names)
     ref = _loop(a, bots_a, 1500)
     got = sum(bots_b.play(t) for t in (1, 499, 1000))

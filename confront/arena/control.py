@@ -20,6 +20,7 @@ import numpy as np
 
 from .core import Arena
 from .observe import Sensing, TargetRule, perceive, remember_scans, select_targets
+from .rules import java_atan2_ufunc, java_hypot_ufunc
 
 __all__ = ["ControlConfig", "nearest_enemy", "move_commands", "gun_radar_commands", "aim", "remember",
            "known_targets", "N_MOVES", "MOVE_NAMES"]
@@ -83,8 +84,8 @@ def aim(x: np.ndarray, y: np.ndarray, gun_heading: np.ndarray, radar_heading: np
 
     Arrays of one shape (or scalars). The rule of PolicyModel.gunRadar and the compiled controller_turn."""
     dx, dy = tx - x, ty - y
-    bearing = np.arctan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise
-    dist = np.hypot(dx, dy)
+    bearing = java_atan2_ufunc(dx, dy)  # absolute angle to the target, 0 = north, clockwise (Math.atan2's bits)
+    dist = java_hypot_ufunc(dx, dy)
     gun = _rel(bearing - gun_heading)
     radar = _rel(bearing - radar_heading)
     radar = radar + np.sign(radar) * cfg.radar_overshoot  # overshoot past the target keeps the radar lock

@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from .kernel_cache import install
+from .rules import java_atan2, java_atan2_ufunc, java_hypot, java_hypot_ufunc
 from .tank import M_DROP, M_E, M_H, M_SEEN, M_TIME, M_TURN, M_V, MEMORY_ROWS
 
 N_REL_BINS = 4
@@ -111,7 +112,7 @@ def normal_absolute_angle(a: float) -> float:
 def absolute_bearing(x: np.ndarray, y: np.ndarray, tx: np.ndarray, ty: np.ndarray) -> np.ndarray:
     """Absolute bearing from (x, y) to (tx, ty), in [0, 2*pi), 0 = north, clockwise."""
     # Robocode heading convention: x += sin(h), y += cos(h), so bearing = atan2(dx, dy)
-    return normal_absolute_angle(np.arctan2(tx - x, ty - y))
+    return normal_absolute_angle(java_atan2_ufunc(tx - x, ty - y))
 
 
 TARGET_RULES: dict[str, int] = {"nearest": 0, "weakest": 1}
@@ -177,7 +178,7 @@ def relative_geometry(
     has = target >= 0
     tx = np.where(has, tx, x)
     ty = np.where(has, ty, y)
-    dist = np.hypot(tx - x, ty - y)
+    dist = java_hypot_ufunc(tx - x, ty - y)
     rel = normal_absolute_angle(absolute_bearing(x, y, tx, ty) - heading)
     rel = np.where(has, rel, 0.0)
     return rel, dist
@@ -217,7 +218,7 @@ state_index_scalar = njit(cache=True)(state_index)  # the same rule compiled for
 
 def field_diagonal(width: float, height: float) -> float:
     """Length of the battlefield diagonal."""
-    return float(np.hypot(width, height))
+    return float(java_hypot(float(width), float(height)))
 
 
 def discrete_state(
@@ -357,8 +358,8 @@ def robot_observation(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray
     (x/W, y/H too when ``feat`` has 9 entries). The same rules as discrete_state() and features()."""
     if tgt >= 0:
         dx, dy = x[tgt] - x[i], y[tgt] - y[i]
-        dist = np.hypot(dx, dy)
-        rel = normal_absolute_angle(normal_absolute_angle(np.arctan2(dx, dy)) - h[i])
+        dist = java_hypot(dx, dy)
+        rel = normal_absolute_angle(normal_absolute_angle(java_atan2(dx, dy)) - h[i])
         te = e[tgt]
     else:
         dist, rel, te = 0.0, 0.0, 0.0

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, vectorize
 
 from .kernel_cache import install
 
@@ -22,7 +22,7 @@ __all__ = [
     "bullet_speed", "bullet_damage", "bullet_hit_bonus", "gun_heat", "clamp_power", "wall_hit_damage",
     "segments_intersect", "segment_intersects_box", "boxes_intersect", "box_contains",
     "sweep_hits_box", "sweep_hits_box_uv", "java_seed", "java_next", "java_next_double", "java_next_int",
-    "java_atan2", "java_hypot",
+    "java_atan2", "java_hypot", "java_atan2_ufunc", "java_hypot_ufunc",
 ]
 
 ACCELERATION = 1.0  # Rules.ACCELERATION
@@ -541,4 +541,16 @@ def java_hypot(x: float, y: float) -> float:
         w = math.sqrt(t1 * y1 - (w * (-w) - (t1 * y2 + t2 * b)))
     return math.ldexp(w, k) if k != 0 else w
 
-install(globals())
+install(globals())  # before the ufuncs below compile java_atan2 / java_hypot at import
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def java_atan2_ufunc(y: float, x: float) -> float:
+    """:func:`java_atan2` as a NumPy ufunc (broadcasting), for the array forms of the robots' geometry."""
+    return java_atan2(y, x)
+
+
+@vectorize(["float64(float64, float64)"], cache=True)
+def java_hypot_ufunc(x: float, y: float) -> float:
+    """:func:`java_hypot` as a NumPy ufunc (broadcasting)."""
+    return java_hypot(x, y)

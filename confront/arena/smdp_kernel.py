@@ -15,6 +15,7 @@ from . import _kernels as K
 from .bots import bots_step
 from .kernel_cache import install
 from .observe import float_mod, perceive_row, remember_scans, reward_eq35_scalar, robot_observation, target_of
+from .rules import java_atan2, java_hypot
 from .state import HIT_ROBOT_SLOTS
 from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
 
@@ -72,8 +73,8 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
         return
     dx = tx - rf[b, K.X, i]
     dy = ty - rf[b, K.Y, i]
-    bearing = np.arctan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise
-    dist = np.hypot(dx, dy)
+    bearing = java_atan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise (Math.atan2's bits)
+    dist = java_hypot(dx, dy)
     gun_turn = _relative(bearing - rf[b, K.GH, i])
     radar_turn = _relative(bearing - rf[b, K.RH, i])
     radar_turn = radar_turn + np.sign(radar_turn) * ctrl[C_OVERSHOOT]
@@ -153,7 +154,7 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     cmd[b, i, 0] = move[b, i, 0] if t == 0 else np.nan
                     cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
                     if t == 0 and move[b, i, 2] > 0 and tg >= 0:  # turn relative to the target's bearing
-                        bearing = np.arctan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
+                        bearing = java_atan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
                         cmd[b, i, 1] = _relative(bearing + move[b, i, 1] - rf[b, K.H, i])
                     cmd[b, i, 2] = np.nan
                     cmd[b, i, 3] = np.nan

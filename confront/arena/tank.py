@@ -57,6 +57,7 @@ import numpy as np
 from numba import njit
 
 from .kernel_cache import install
+from .rules import java_atan2, java_hypot
 
 __all__ = ["TankSpace", "MEMORY_ROWS", "n_features", "tank_view_row", "tank_view_kernel", "lead_point",
            "action_table", "FEATURE_NAMES"]
@@ -172,7 +173,7 @@ def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, r
             oy = mv / rate * (np.sin(a) - sh)
         px = min(max(mx + ox, WALL_MARGIN), width - WALL_MARGIN)
         py = min(max(my + oy, WALL_MARGIN), height - WALL_MARGIN)
-        t_new = np.hypot(px - x, py - y) / speed
+        t_new = java_hypot(px - x, py - y) / speed
         if t_new == t:  # a fixed point: every further iteration gives the same point
             break
         t = t_new
@@ -191,7 +192,7 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
     message arrives the turn after it is sent), none when not ``mates_ok`` (a round's first turn). Slots are
     filled nearest first (ties: lower index)."""
     n = x.shape[0]
-    diag = np.hypot(width, height)
+    diag = java_hypot(width, height)
     for q in range(out.shape[0]):
         out[q] = 0.0
     for q in range(k_slots):
@@ -224,7 +225,7 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
         if team[j] == team[i] or not alive[j] or seen[i, j] < 0:
             dist[j] = np.inf
         else:
-            dist[j] = np.hypot(memory[M_X, i, j] - x[i], memory[M_Y, i, j] - y[i])
+            dist[j] = java_hypot(memory[M_X, i, j] - x[i], memory[M_Y, i, j] - y[i])
     for s in range(k_slots):
         best, best_d = -1, np.inf
         for j in range(n):
@@ -235,7 +236,7 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
         dist[best] = np.inf
         slots[s] = best
         o = OWN_FEATURES + ENEMY_FEATURES * s
-        bearing = np.arctan2(memory[M_X, i, best] - x[i], memory[M_Y, i, best] - y[i])
+        bearing = java_atan2(memory[M_X, i, best] - x[i], memory[M_Y, i, best] - y[i])
         rel = bearing - h[i]
         rel_h = memory[M_H, i, best] - bearing
         out[o] = 1.0
@@ -254,7 +255,7 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
             if j == i or team[j] != team[i] or not alive[j]:
                 dist[j] = np.inf
             else:
-                dist[j] = np.hypot(mates[0, j] - x[i], mates[1, j] - y[i])
+                dist[j] = java_hypot(mates[0, j] - x[i], mates[1, j] - y[i])
     for s in range(m_used):
         best, best_d = -1, np.inf
         for j in range(n):
@@ -264,7 +265,7 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
             break
         dist[best] = np.inf
         o = OWN_FEATURES + ENEMY_FEATURES * k_slots + MATE_FEATURES * s
-        rel = np.arctan2(mates[0, best] - x[i], mates[1, best] - y[i]) - h[i]
+        rel = java_atan2(mates[0, best] - x[i], mates[1, best] - y[i]) - h[i]
         out[o] = 1.0
         out[o + 1] = np.sin(rel)
         out[o + 2] = np.cos(rel)

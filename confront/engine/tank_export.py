@@ -32,6 +32,7 @@ import numpy as np
 
 from confront.arena.control import ControlConfig
 from confront.arena.observe import float_mod
+from confront.arena.rules import java_atan2, java_hypot
 from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
 from confront.engine.export import ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
@@ -140,7 +141,7 @@ def body_turn(space: TankSpace, x: float, y: float, heading: float, enemies: Seq
     if space.turn_mode != "target" or target < 0:
         return turn
     row = enemies[target]
-    return _relative(math.atan2(row[0] - x, row[1] - y) + turn - heading)
+    return _relative(java_atan2(row[0] - x, row[1] - y) + turn - heading)
 
 
 def robot_control(control: ControlConfig, lead: str, x: float, y: float, gun_heading: float, radar_heading: float,
@@ -159,8 +160,8 @@ def robot_control(control: ControlConfig, lead: str, x: float, y: float, gun_hea
         tx, ty = lead_point(x, y, tx, ty, float(row[3]), float(row[4]), rate, float(time - row[6]),
                             power if power > 0 else 2.0, float(width), float(height))
     dx, dy = tx - x, ty - y
-    bearing = math.atan2(dx, dy)
-    dist = math.hypot(dx, dy)
+    bearing = java_atan2(dx, dy)  # Math.atan2's bits, as TankModel
+    dist = java_hypot(dx, dy)
     gun = _relative(bearing - gun_heading)
     radar = _relative(bearing - radar_heading)
     radar = radar + float(np.sign(radar)) * control.radar_overshoot

@@ -54,6 +54,7 @@ MATCHUPS = (
     Matchup("SpinBot vs Walls", (("SpinBot",), ("Walls",))),
     Matchup("Tracker vs RamFire", (("Tracker",), ("RamFire",))),
     Matchup("Fire vs Corners", (("Fire",), ("Corners",))),
+    Matchup("Fire vs RamFire", (("Fire",), ("RamFire",))),
     Matchup("Crazy vs SittingDuck", (("Crazy",), ("SittingDuck",))),
     Matchup("TrackFire vs Tracker", (("TrackFire",), ("Tracker",))),
     Matchup("TrackFire vs SpinBot", (("TrackFire",), ("SpinBot",))),

@@ -64,7 +64,7 @@ from .state import (
 
 # field positions inside the packed groups (compile-time constants for numba)
 X, Y, H, GH, RH, V, E, HEAT, BX, BY, DIST, BODYREM, GUNREM, RADREM, MAXV, MAXTURN, ASSIST, \
-    EVWALLB, EVROBB, EVBULB, EVROBN = range(len(RF_FIELDS) - 4 * HIT_ROBOT_SLOTS)
+    EVWALLB, EVROBB, EVBULB, EVBULH, EVROBN = range(len(RF_FIELDS) - 4 * HIT_ROBOT_SLOTS)
 EVROB0 = EVROBN + 1  # slot k: robot at EVROB0 + 4k, then bearing, at fault, the other's energy
 ALIVE, OVERDRIVE, INCOLL, TRWG, WINNER, ADV, LEADER, DROID, ADJGB, ADJRB, ADJRG, \
     EVWALL, EVFAULT, EVFIRED, EVDIED, SCANREQ = range(len(RB_FIELDS))
@@ -332,12 +332,15 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
                     if not team_fire:
                         score[b, owner, S_BKILL] += 0.2 * _team_ledger(ri, ledger, b, owner, j)
                 # 3p back to the shooter (Rules.getBulletHitBonus), even if it died this turn; a robot dead
-                # since an earlier turn has stopped (RobotPeer.updateEnergy: isExecFinishedAndDisabled)
+                # since an earlier turn has stopped (RobotPeer.updateEnergy: isExecFinishedAndDisabled). The engine
+                # sets that flag on the dead robot's own thread, which the battle does not wait for
+                # (Battle.wakeupSerial), so now and then the bonus still lands there: a race, not a rule
                 if (rb[b, ALIVE, owner] or rb[b, EVDIED, owner]) and \
                         not (bb_decided and bi[b, ENDT] >= HALT_TURNS + 2):
                     _set_energy(rf, bi, bf, b, owner, rf[b, E, owner] + bullet_hit_bonus(p), True)
                 ri[b, EVHITBY, j] += 1
                 rf[b, EVBULB, j] = normal_relative_angle(kf[b, KH, s] + math.pi - rf[b, H, j])
+                rf[b, EVBULH, j] = kf[b, KH, s]  # HitByBulletEvent.getHeading(): the bullet's own heading
                 if rb[b, ALIVE, owner] or rb[b, EVDIED, owner]:  # a stopped robot gets no events
                     ri[b, EVBHIT, owner] += 1
                 if box_contains(rf[b, BX, j], rf[b, BY, j], lx, ly):

@@ -450,7 +450,7 @@ def _before(mem, b, i, k, m):
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-             ev_hitby, ev_hitby_bearing, hr, has_hr):
+             ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, has_hr):
     """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns."""
     n = x.shape[1]
     if has_hr:  # one HitRobotEvent per collision, in the engine's order (RobotPeer.checkRobotCollision)
@@ -465,9 +465,9 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
     if ev_wall[b, i]:
         _add_event(mem, b, i, P_WALL, -1.0, 0.0, 0.0, 0.0, 0.0)
     if ev_hitby[b, i] > 0:
-        # the bullet's heading: back along the bearing it came from
-        _add_event(mem, b, i, P_BULLET, -1.0, ev_hitby_bearing[b, i], 0.0, 0.0,
-                   ev_hitby_bearing[b, i] + h[b, i] - math.pi)
+        # the event carries the bullet's own heading (Bullet.getHeadingRadians; BulletPeer's heading), not
+        # bearing + body heading - pi, which can be an ulp off
+        _add_event(mem, b, i, P_BULLET, -1.0, ev_hitby_bearing[b, i], 0.0, 0.0, ev_hitby_heading[b, i])
     for j2 in range(n):
         if scanned[b, i, j2] and alive[b, j2]:
             dx = x[b, j2] - x[b, i]
@@ -659,7 +659,7 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-                 ev_hitby_bearing, ev_died, width, height, cmd, rem, hr, has_hr, heat):
+                 ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hr, has_hr, heat):
     """One decision of battle b's scripted robots (their robot time between two turns).
 
     Each robot resumes inside the execute() of its running blocking call: EventManager.processEvents first
@@ -690,7 +690,7 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
         rem[2] = gun_rem[b, i]
         rem[3] = radar_rem[b, i]
         _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-                 ev_hitby, ev_hitby_bearing, hr, has_hr)
+                 ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, has_hr)
         lv = _top_level(mem, b, i)
         process = True
         for _ in range(48):
@@ -754,7 +754,7 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-              ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, heat):
+              ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots, heat):
     """One decision of every scripted robot (their robot time between two turns).
 
     ``hit_robots``: the arena's per-collision HitRobot rows (``rf[:, EVROBN:EVROBN + 1 + 4 * HIT_ROBOT_SLOTS]``);
@@ -763,7 +763,8 @@ def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_r
     for b in range(x.shape[0]):
         _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
                      radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-                     ev_hitby, ev_hitby_bearing, ev_died, width, height, cmd, rem, hit_robots, True, heat)
+                     ev_hitby, ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots,
+                     True, heat)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
@@ -790,6 +791,7 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
     x, y, h, gh, rh, energy = rf[:, K.X], rf[:, K.Y], rf[:, K.H], rf[:, K.GH], rf[:, K.RH], rf[:, K.E]
     dist, body, gun, radar = rf[:, K.DIST], rf[:, K.BODYREM], rf[:, K.GUNREM], rf[:, K.RADREM]
     maxv, assist, ev_robb, ev_bulb = rf[:, K.MAXV], rf[:, K.ASSIST], rf[:, K.EVROBB], rf[:, K.EVBULB]
+    ev_bulh = rf[:, K.EVBULH]
     alive, scan_req, ev_wall, ev_fault, ev_died = rb[:, K.ALIVE], rb[:, K.SCANREQ], rb[:, K.EVWALL], \
         rb[:, K.EVFAULT], rb[:, K.EVDIED]
     hr, heat = rf[:, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[:, K.HEAT]
@@ -806,8 +808,8 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
                         cmd[b, i, c] = math.nan
                     cmd[b, i, 4] = 0.0
             _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist, body, gun, radar, maxv, assist,
-                         scan_req, scanned, ev_wall, ev_robot, ev_robb, ev_fault, ev_hitby, ev_bulb, ev_died, width,
-                         height, cmd, rem, hr, True, heat)
+                         scan_req, scanned, ev_wall, ev_robot, ev_robb, ev_fault, ev_hitby, ev_bulb, ev_bulh, ev_died,
+                         width, height, cmd, rem, hr, True, heat)
             if not bb[b, K.DONE]:
                 K.step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                                  placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
@@ -933,7 +935,8 @@ class ScriptedBots:
                 s.energy[r], s.alive[r], s.team[r], s.distance_remaining[r], s.body_turn_remaining[r],
                 s.gun_turn_remaining[r], s.radar_turn_remaining[r], s.max_velocity[r], s.fire_assist[r],
                 s.scan_request[r], s.scanned[r], s.ev_hit_wall[r], s.ev_hit_robot[r], s.ev_hit_robot_bearing[r],
-                s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r], s.ev_died[r],
+                s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r],
+                s.ev_hit_by_bullet_heading[r], s.ev_died[r],
                 float(self.arena.scenario.width), float(self.arena.scenario.height)), np.zeros(4),
                 (s.packed["rf"][r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], s.gun_heat[r])))
 

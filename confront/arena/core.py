@@ -37,7 +37,8 @@ this turn even if nothing moved; consumed at load), flags ``team`` (int), ``is_a
 
 Events of the last turn ``(B, R)``: ``ev_hit_wall`` / ``ev_hit_wall_bearing``, ``ev_hit_robot``
 (index of the robot hit, -1 none) / ``ev_hit_robot_bearing`` / ``ev_at_fault``,
-``ev_hit_by_bullet`` (count) / ``ev_hit_by_bullet_bearing``, ``ev_bullet_hit`` (count),
+``ev_hit_by_bullet`` (count) / ``ev_hit_by_bullet_bearing`` / ``ev_hit_by_bullet_heading`` (the last bullet's
+own heading, as HitByBulletEvent.getHeading() reports it), ``ev_bullet_hit`` (count),
 ``ev_bullet_missed`` (count), ``ev_fired``, ``ev_died``.
 
 Radar ``(B, R, R)``: ``scanned[b, i, j]`` robot i's radar swept robot j this turn (Robocode's
@@ -235,7 +236,13 @@ class Arena:
         return {name: np.array(self.state.arrays[name], copy=True) for name in FIELDS}
 
     def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
-        """Restore the arrays written by :meth:`state_dict` (same scenario and battle count)."""
+        """Restore the arrays written by :meth:`state_dict` (same scenario and battle count).
+
+        A dict saved before ``ev_hit_by_bullet_heading`` existed gets it as the arena rebuilt it then
+        (bearing + body heading - pi)."""
+        if "ev_hit_by_bullet_heading" not in d and "ev_hit_by_bullet_bearing" in d and "heading" in d:
+            d = dict(d, ev_hit_by_bullet_heading=np.asarray(d["ev_hit_by_bullet_bearing"]) + np.asarray(d["heading"])
+                     - math.pi)
         for name in FIELDS:
             if name not in d:
                 raise ValueError(f"state dict lacks {name!r}")

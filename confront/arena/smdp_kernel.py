@@ -101,7 +101,7 @@ def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, width, height, cmd, rem
               rb[r, K.ALIVE], ri[r, K.TEAM], rf[r, K.DIST], rf[r, K.BODYREM], rf[r, K.GUNREM],
               rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
               rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
-              rf[r, K.EVBULB], rb[r, K.EVDIED], width, height, cmd[r], rem,
+              rf[r, K.EVBULB], rf[r, K.EVBULH], rb[r, K.EVDIED], width, height, cmd[r], rem,
               rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.HEAT])
 
 

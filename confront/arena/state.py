@@ -29,7 +29,7 @@ B_NONE, B_FIRED, B_MOVING, B_HIT_VICTIM, B_HIT_BULLET, B_HIT_WALL, B_EXPLODED = 
 RF_FIELDS = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "energy", "gun_heat",
              "box_x", "box_y", "distance_remaining", "body_turn_remaining", "gun_turn_remaining",
              "radar_turn_remaining", "max_velocity", "max_turn_rate", "fire_assist",
-             "ev_hit_wall_bearing", "ev_hit_robot_bearing", "ev_hit_by_bullet_bearing")
+             "ev_hit_wall_bearing", "ev_hit_robot_bearing", "ev_hit_by_bullet_bearing", "ev_hit_by_bullet_heading")
 # every HitRobotEvent of the last turn in the engine's order (one per collision, RobotPeer.checkRobotCollision):
 # the count, then per slot the other robot, the bearing, the at-fault flag (1.0 / 0.0) and the other's energy
 # just after the hit; the single ev_hit_robot* fields keep the last one

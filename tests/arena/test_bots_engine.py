@@ -31,6 +31,7 @@ FIXES = {
     "sample_trackfire": "sample.TrackFire (degrees, gun heat, its onWin spin)",
     "sample_myfirstteam": "sampleteam.MyFirstTeam: the leader's Point messages read by the droids a turn later",
     "sample_trackfire_ramfire_team": "Java's atan2 (fdlibm) for scan bearings: TrackFire's bearingFromGun == 0 test",
+    "sample_fire_hitby_heading": "HitByBulletEvent carries the bullet's own heading (Fire's turn in onHitByBullet)",
 }
 
 

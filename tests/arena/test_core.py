@@ -198,6 +198,20 @@ def test_state_dict_round_trip_continues_identically():
         np.testing.assert_array_equal(b.state.rng, r)
 
 
+def test_state_dict_saved_before_the_bullet_heading_field_loads():
+    """A dict without ``ev_hit_by_bullet_heading`` (saved before it existed) gets bearing + heading - pi."""
+    a = Arena("1v1", 2, seed=3)
+    for _ in range(5):
+        a.step(a.idle_commands())
+    a.state.ev_hit_by_bullet_bearing[...] = 0.5
+    saved = a.state_dict()
+    del saved["ev_hit_by_bullet_heading"]
+    b = Arena("1v1", 2, seed=4)
+    b.load_state_dict(saved)
+    np.testing.assert_array_equal(b.state.x, a.state.x)
+    np.testing.assert_array_equal(b.state.ev_hit_by_bullet_heading, 0.5 + a.state.heading - math.pi)
+
+
 def test_reset_mask_only_touches_masked_battles():
     a = Arena("1v1", 3, seed=1)
     for _ in range(5):

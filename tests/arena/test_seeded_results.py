@@ -15,8 +15,10 @@ THEM4 = ["Walls", "Tracker", "Crazy", "Fire"]
 # engine trace in tests/fixtures/traces/samples, tests/arena/test_bots_engine.py): one HitRobotEvent per
 # collision, disabled robots run on, a dying robot's last wake and the interruptible flag kept across rounds,
 # stop()/resume() at a round start, degree arithmetic, onWin; re-recorded again for Java's atan2 / hypot
-# (fdlibm, rules.java_atan2: scan and collision bearings, scan distances). fire_corners is unchanged. (Before:
-# the event queue of commit 69360a4; before that commit 34b3372 used the newest event only.)
+# (fdlibm, rules.java_atan2: scan and collision bearings, scan distances). 4v4 re-recorded again (2026-12-03) for
+# the HitByBulletEvent's heading, now the bullet's own (Fire's onHitByBullet turn; engine trace
+# sample_fire_hitby_heading); melee4 has no Fire, fire_corners is unchanged. (Before: the event queue of
+# commit 69360a4; before that commit 34b3372 used the newest event only.)
 RECORDED = {
     "melee4": (OURS4, None, 3,
                [[600.0, 0.0, 521.0000000000003, 24.56000000000007, 16.8, 0.0],
@@ -28,15 +30,15 @@ RECORDED = {
                      [[300.0, 60.0, 623.0, 124.60000000000001, 0.0, 0.0], [0.0, 0.0, 392.0, 0.0, 0.0, 0.0]],
                      [[6, 0, 0], [0, 6, 0]]),
     "4v4": (OURS4 + THEM4, "4v4", 11,
-            [[850.0, 0.0, 255.0, 15.8, 23.999999999999993, 0.0],
-             [700.0, 0.0, 325.5999999999999, 93.24000000000004, 7.2, 0.0],
-             [500.0, 0.0, 639.6000000000001, 85.96000000000001, 15.599999999999998, 0.0],
-             [300.0, 0.0, 209.20000000000022, 0.0, 52.8, 13.320000000000002],
-             [1200.0, 240.0, 553.6000000000001, 80.80000000000004, 2.4, 0.0],
-             [350.0, 0.0, 543.6000000000003, 65.96000000000005, 7.199999999999999, 31.139999999999997],
-             [600.0, 40.0, 156.40000000000015, 10.4, 29.999999999999993, 0.0],
-             [300.0, 0.0, 308.0, 0.0, 2.4, 0.0]],
-            [[0, 1, 0], [0, 5, 0], [0, 0, 0], [0, 0, 0], [6, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]]),
+            [[850.0, 0.0, 291.0, 35.52, 22.799999999999997, 0.0],
+             [700.0, 0.0, 277.19999999999993, 94.64000000000004, 6.0, 0.0],
+             [600.0, 0.0, 703.6000000000001, 85.96000000000001, 14.399999999999999, 0.0],
+             [450.0, 0.0, 177.20000000000022, 0.0, 43.19999999999999, 13.320000000000002],
+             [1200.0, 240.0, 710.8000000000002, 124.24000000000004, 2.4, 0.0],
+             [300.0, 0.0, 431.60000000000025, 65.96000000000005, 6.0, 31.139999999999997],
+             [500.0, 40.0, 144.40000000000015, 10.4, 29.999999999999993, 0.0],
+             [200.0, 0.0, 256.0, 0.0, 2.4, 0.0]],
+            [[0, 2, 0], [0, 4, 0], [0, 0, 0], [0, 0, 0], [6, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0]]),
 }
 
 

@@ -54,6 +54,7 @@ from .state import (
     BB_FIELDS,
     BF_FIELDS,
     BI_FIELDS,
+    HIT_BY_BULLET_SLOTS,
     HIT_ROBOT_SLOTS,
     KF_FIELDS,
     KI_FIELDS,
@@ -64,8 +65,10 @@ from .state import (
 
 # field positions inside the packed groups (compile-time constants for numba)
 X, Y, H, GH, RH, V, E, HEAT, BX, BY, DIST, BODYREM, GUNREM, RADREM, MAXV, MAXTURN, ASSIST, \
-    EVWALLB, EVROBB, EVBULB, EVBULH, EVROBN = range(len(RF_FIELDS) - 4 * HIT_ROBOT_SLOTS)
+    EVWALLB, EVROBB, EVBULB, EVBULH, EVROBN = range(len(RF_FIELDS) - 4 * HIT_ROBOT_SLOTS - 1 - 2 * HIT_BY_BULLET_SLOTS)
 EVROB0 = EVROBN + 1  # slot k: robot at EVROB0 + 4k, then bearing, at fault, the other's energy
+EVBULN = EVROB0 + 4 * HIT_ROBOT_SLOTS  # HitByBulletEvents of the turn (count)
+EVBUL0 = EVBULN + 1  # slot k: bearing at EVBUL0 + 2k, the bullet's heading at EVBUL0 + 2k + 1
 ALIVE, OVERDRIVE, INCOLL, TRWG, WINNER, ADV, LEADER, DROID, ADJGB, ADJRB, ADJRG, \
     EVWALL, EVFAULT, EVFIRED, EVDIED, SCANREQ = range(len(RB_FIELDS))
 TEAM, EVROBOT, EVHITBY, EVBHIT, EVMISSED = range(len(RI_FIELDS))
@@ -341,6 +344,12 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
                 ri[b, EVHITBY, j] += 1
                 rf[b, EVBULB, j] = normal_relative_angle(kf[b, KH, s] + math.pi - rf[b, H, j])
                 rf[b, EVBULH, j] = kf[b, KH, s]  # HitByBulletEvent.getHeading(): the bullet's own heading
+                # one HitByBulletEvent per bullet, in the engine's bullet order (BulletPeer.checkRobotCollision)
+                kb = int(rf[b, EVBULN, j])
+                if kb < HIT_BY_BULLET_SLOTS:
+                    rf[b, EVBUL0 + 2 * kb, j] = rf[b, EVBULB, j]
+                    rf[b, EVBUL0 + 2 * kb + 1, j] = rf[b, EVBULH, j]
+                    rf[b, EVBULN, j] = kb + 1
                 if rb[b, ALIVE, owner] or rb[b, EVDIED, owner]:  # a stopped robot gets no events
                     ri[b, EVBHIT, owner] += 1
                 if box_contains(rf[b, BX, j], rf[b, BY, j], lx, ly):
@@ -655,6 +664,7 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
 def _clear_events(b, i, rb, ri, scanned, rf):
     """Forget robot i's events and scans of the last turn (each turn starts with none)."""
     rf[b, EVROBN, i] = 0.0
+    rf[b, EVBULN, i] = 0.0
     rb[b, EVWALL, i] = False
     rb[b, EVFAULT, i] = False
     rb[b, EVFIRED, i] = False
@@ -822,6 +832,7 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
             rb[b, EVFAULT, i] = False
             rb[b, EVDIED, i] = False
             rf[b, EVROBN, i] = 0.0
+            rf[b, EVBULN, i] = 0.0
             ri[b, EVROBOT, i] = -1
             ri[b, EVHITBY, i] = 0
             ri[b, EVBHIT, i] = 0

@@ -36,7 +36,7 @@ from .core import Arena, _pool
 from .kernel_cache import install
 from .rules import java_atan2, java_hypot, normal_absolute_angle, normal_relative_angle
 from .scenarios import Scenario
-from .state import HIT_ROBOT_SLOTS
+from .state import HIT_BY_BULLET_SLOTS, HIT_ROBOT_SLOTS
 
 __all__ = ["BOT_NAMES", "ADVANCED_BOTS", "ScriptedBots", "bot_kind", "bot_battle"]
 
@@ -450,7 +450,7 @@ def _before(mem, b, i, k, m):
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-             ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, has_hr):
+             ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, hb, has_hr):
     """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns."""
     n = x.shape[1]
     if has_hr:  # one HitRobotEvent per collision, in the engine's order (RobotPeer.checkRobotCollision)
@@ -464,7 +464,10 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
                        1.0 if ev_fault[b, i] else 0.0)
     if ev_wall[b, i]:
         _add_event(mem, b, i, P_WALL, -1.0, 0.0, 0.0, 0.0, 0.0)
-    if ev_hitby[b, i] > 0:
+    if has_hr:  # one HitByBulletEvent per bullet, in the engine's bullet order (BulletPeer.checkRobotCollision)
+        for k in range(min(int(hb[b, 0, i]), HIT_BY_BULLET_SLOTS)):
+            _add_event(mem, b, i, P_BULLET, -1.0, hb[b, 1 + 2 * k, i], 0.0, 0.0, hb[b, 2 + 2 * k, i])
+    elif ev_hitby[b, i] > 0:
         # the event carries the bullet's own heading (Bullet.getHeadingRadians; BulletPeer's heading), not
         # bearing + body heading - pi, which can be an ulp off
         _add_event(mem, b, i, P_BULLET, -1.0, ev_hitby_bearing[b, i], 0.0, 0.0, ev_hitby_heading[b, i])
@@ -659,7 +662,7 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-                 ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hr, has_hr, heat):
+                 ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hr, hb, has_hr, heat):
     """One decision of battle b's scripted robots (their robot time between two turns).
 
     Each robot resumes inside the execute() of its running blocking call: EventManager.processEvents first
@@ -690,7 +693,7 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
         rem[2] = gun_rem[b, i]
         rem[3] = radar_rem[b, i]
         _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-                 ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, has_hr)
+                 ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, hb, has_hr)
         lv = _top_level(mem, b, i)
         process = True
         for _ in range(48):
@@ -754,17 +757,19 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-              ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots, heat):
+              ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots, hit_by_bullets,
+              heat):
     """One decision of every scripted robot (their robot time between two turns).
 
     ``hit_robots``: the arena's per-collision HitRobot rows (``rf[:, EVROBN:EVROBN + 1 + 4 * HIT_ROBOT_SLOTS]``);
+    ``hit_by_bullets``: its per-bullet HitByBullet rows (``rf[:, EVBULN:EVBULN + 1 + 2 * HIT_BY_BULLET_SLOTS]``);
     ``heat``: the gun heats (TrackFire reads them). One call signature only: each variant is a compile.
     """
     for b in range(x.shape[0]):
         _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
                      radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
                      ev_hitby, ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots,
-                     True, heat)
+                     hit_by_bullets, True, heat)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
@@ -795,6 +800,7 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
     alive, scan_req, ev_wall, ev_fault, ev_died = rb[:, K.ALIVE], rb[:, K.SCANREQ], rb[:, K.EVWALL], \
         rb[:, K.EVFAULT], rb[:, K.EVDIED]
     hr, heat = rf[:, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[:, K.HEAT]
+    hb = rf[:, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS]
     team, ev_robot, ev_hitby = ri[:, K.TEAM], ri[:, K.EVROBOT], ri[:, K.EVHITBY]
     total = 0
     for b in range(b0, b1):
@@ -809,7 +815,7 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
                     cmd[b, i, 4] = 0.0
             _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist, body, gun, radar, maxv, assist,
                          scan_req, scanned, ev_wall, ev_robot, ev_robb, ev_fault, ev_hitby, ev_bulb, ev_bulh, ev_died,
-                         width, height, cmd, rem, hr, True, heat)
+                         width, height, cmd, rem, hr, hb, True, heat)
             if not bb[b, K.DONE]:
                 K.step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
                                  placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
@@ -938,7 +944,8 @@ class ScriptedBots:
                 s.ev_at_fault[r], s.ev_hit_by_bullet[r], s.ev_hit_by_bullet_bearing[r],
                 s.ev_hit_by_bullet_heading[r], s.ev_died[r],
                 float(self.arena.scenario.width), float(self.arena.scenario.height)), np.zeros(4),
-                (s.packed["rf"][r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], s.gun_heat[r])))
+                (s.packed["rf"][r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS],
+                 s.packed["rf"][r, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS], s.gun_heat[r])))
 
     def _run(self, k: int, cmd: np.ndarray) -> None:
         """bots_step on battle chunk k."""

@@ -38,7 +38,9 @@ this turn even if nothing moved; consumed at load), flags ``team`` (int), ``is_a
 Events of the last turn ``(B, R)``: ``ev_hit_wall`` / ``ev_hit_wall_bearing``, ``ev_hit_robot``
 (index of the robot hit, -1 none) / ``ev_hit_robot_bearing`` / ``ev_at_fault``,
 ``ev_hit_by_bullet`` (count) / ``ev_hit_by_bullet_bearing`` / ``ev_hit_by_bullet_heading`` (the last bullet's
-own heading, as HitByBulletEvent.getHeading() reports it), ``ev_bullet_hit`` (count),
+own heading, as HitByBulletEvent.getHeading() reports it); every bullet's in the engine's bullet order:
+``ev_hit_by_bullets`` (rows, at most ``HIT_BY_BULLET_SLOTS``) / ``ev_hit_by_bullet_{k}_bearing`` /
+``ev_hit_by_bullet_{k}_heading``; ``ev_bullet_hit`` (count),
 ``ev_bullet_missed`` (count), ``ev_fired``, ``ev_died``.
 
 Radar ``(B, R, R)``: ``scanned[b, i, j]`` robot i's radar swept robot j this turn (Robocode's
@@ -76,7 +78,7 @@ import numpy as np
 from . import _kernels as K
 from .rules import java_next_double, java_seed
 from .scenarios import Scenario, get_scenario
-from .state import FIELDS, ArenaState, allocate
+from .state import FIELDS, HIT_BY_BULLET_SLOTS, ArenaState, allocate
 
 __all__ = ["Arena", "ORDER_MODES"]
 
@@ -239,10 +241,19 @@ class Arena:
         """Restore the arrays written by :meth:`state_dict` (same scenario and battle count).
 
         A dict saved before ``ev_hit_by_bullet_heading`` existed gets it as the arena rebuilt it then
-        (bearing + body heading - pi)."""
+        (bearing + body heading - pi); one saved before the per-bullet rows (``ev_hit_by_bullets``) gets one
+        row, the last bullet's, as the bots read it then (one HitByBulletEvent a turn)."""
         if "ev_hit_by_bullet_heading" not in d and "ev_hit_by_bullet_bearing" in d and "heading" in d:
             d = dict(d, ev_hit_by_bullet_heading=np.asarray(d["ev_hit_by_bullet_bearing"]) + np.asarray(d["heading"])
                      - math.pi)
+        if "ev_hit_by_bullets" not in d and "ev_hit_by_bullet" in d and "ev_hit_by_bullet_heading" in d:
+            count = np.asarray(d["ev_hit_by_bullet"])
+            rows = {"ev_hit_by_bullets": np.minimum(count, 1).astype(np.float64)}
+            for k in range(HIT_BY_BULLET_SLOTS):
+                for f in ("bearing", "heading"):
+                    last = np.asarray(d[f"ev_hit_by_bullet_{f}"], dtype=np.float64)
+                    rows[f"ev_hit_by_bullet_{k}_{f}"] = last.copy() if k == 0 else np.zeros_like(last)
+            d = dict(d, **rows)
         for name in FIELDS:
             if name not in d:
                 raise ValueError(f"state dict lacks {name!r}")

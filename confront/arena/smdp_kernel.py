@@ -16,7 +16,7 @@ from .bots import bots_step
 from .kernel_cache import install
 from .observe import float_mod, perceive_row, remember_scans, reward_eq35_scalar, robot_observation, target_of
 from .rules import java_atan2, java_hypot
-from .state import HIT_ROBOT_SLOTS
+from .state import HIT_BY_BULLET_SLOTS, HIT_ROBOT_SLOTS
 from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
 
 C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = range(9)
@@ -102,7 +102,8 @@ def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, width, height, cmd, rem
               rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
               rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
               rf[r, K.EVBULB], rf[r, K.EVBULH], rb[r, K.EVDIED], width, height, cmd[r], rem,
-              rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.HEAT])
+              rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS],
+              rf[r, K.HEAT])
 
 
 @njit(cache=True, nogil=True)

@@ -36,6 +36,12 @@ RF_FIELDS = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "e
 HIT_ROBOT_SLOTS = 4
 RF_FIELDS += ("ev_hit_robots",) + tuple(f"ev_hit_robot_{k}_{f}" for k in range(HIT_ROBOT_SLOTS)
                                         for f in ("robot", "bearing", "fault", "energy"))
+# every HitByBulletEvent of the last turn in the engine's bullet order (one per bullet, BulletPeer.checkRobotCollision):
+# the count (at most HIT_BY_BULLET_SLOTS; ev_hit_by_bullet counts them all), then per slot the event's bearing and the
+# bullet's own heading; ev_hit_by_bullet_bearing / _heading keep the last one
+HIT_BY_BULLET_SLOTS = 4
+RF_FIELDS += ("ev_hit_by_bullets",) + tuple(f"ev_hit_by_bullet_{k}_{f}" for k in range(HIT_BY_BULLET_SLOTS)
+                                            for f in ("bearing", "heading"))
 RB_FIELDS = ("alive", "overdriving", "in_collision", "turned_radar_with_gun", "winner", "is_advanced",
              "is_leader", "is_droid", "adjust_gun_for_body", "adjust_radar_for_body", "adjust_radar_for_gun",
              "ev_hit_wall", "ev_at_fault", "ev_fired", "ev_died", "scan_request")

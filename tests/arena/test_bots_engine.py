@@ -32,6 +32,7 @@ FIXES = {
     "sample_myfirstteam": "sampleteam.MyFirstTeam: the leader's Point messages read by the droids a turn later",
     "sample_trackfire_ramfire_team": "Java's atan2 (fdlibm) for scan bearings: TrackFire's bearingFromGun == 0 test",
     "sample_fire_hitby_heading": "HitByBulletEvent carries the bullet's own heading (Fire's turn in onHitByBullet)",
+    "sample_hitby_per_bullet": "one HitByBulletEvent per bullet, in the engine's bullet order (Fire hit twice)",
 }
 
 
@@ -119,3 +120,23 @@ def test_tracker_aims_from_the_older_scan():
     dg_sim = np.diff(np.unwrap(sim[0][:200, 0, 3]))
     assert np.abs(dg).max() > 0.1
     np.testing.assert_allclose(dg_sim, dg, atol=1e-9)
+
+
+def test_fire_gets_one_hit_by_bullet_event_per_bullet():
+    """Hand check of sample_hitby_per_bullet: two bullets hit Fire in turn 43, each with its own heading; the
+    engine's Fire turns perpendicular to the first one in the bullet order (271.3 deg), not the last (324.6)."""
+    head, eng = _load("sample_hitby_per_bullet")
+    sc = get_scenario("melee").replace(teams=tuple(head["teams"]), turns_after_end=150, max_turns=100000)
+    arena = Arena(sc, 1, seed=head["seed"], order="engine")
+    bots = ScriptedBots(arena, head["robots"])
+    cmd = arena.idle_commands()
+    s = arena.state
+    for _ in range(43):
+        bots.commands(cmd)
+        arena.step(cmd)
+    assert s.ev_hit_by_bullet[0, 0] == 2 and s.ev_hit_by_bullets[0, 0] == 2
+    headings = [math.degrees(s.ev_hit_by_bullet_0_heading[0, 0]), math.degrees(s.ev_hit_by_bullet_1_heading[0, 0])]
+    np.testing.assert_allclose(headings, [271.3231104652008, 324.5595766884766])
+    assert s.ev_hit_by_bullet_heading[0, 0] == s.ev_hit_by_bullet_1_heading[0, 0]  # the single field keeps the last
+    # the engine's Fire turns its body 10 deg a turn from turn 44 on (the first bullet's 70.6 deg turn)
+    np.testing.assert_allclose(np.diff(eng[0][43:48, 0, 2]), -math.radians(10.0), atol=1e-12)

@@ -212,6 +212,25 @@ def test_state_dict_saved_before_the_bullet_heading_field_loads():
     np.testing.assert_array_equal(b.state.ev_hit_by_bullet_heading, 0.5 + a.state.heading - math.pi)
 
 
+def test_state_dict_saved_before_the_per_bullet_rows_loads():
+    """A dict without ``ev_hit_by_bullets`` (saved before the per-bullet rows) gets one row: the last bullet's."""
+    a = Arena("1v1", 2, seed=3)
+    for _ in range(5):
+        a.step(a.idle_commands())
+    a.state.ev_hit_by_bullet[...] = 2
+    a.state.ev_hit_by_bullet_bearing[...] = 0.5
+    a.state.ev_hit_by_bullet_heading[...] = 1.5
+    saved = a.state_dict()
+    for name in [n for n in saved if n.startswith("ev_hit_by_bullet_") and n[17].isdigit()] + ["ev_hit_by_bullets"]:
+        del saved[name]
+    b = Arena("1v1", 2, seed=4)
+    b.load_state_dict(saved)
+    np.testing.assert_array_equal(b.state.ev_hit_by_bullets, 1.0)
+    np.testing.assert_array_equal(b.state.ev_hit_by_bullet_0_bearing, 0.5)
+    np.testing.assert_array_equal(b.state.ev_hit_by_bullet_0_heading, 1.5)
+    np.testing.assert_array_equal(b.state.ev_hit_by_bullet_1_heading, 0.0)
+
+
 def test_reset_mask_only_touches_masked_battles():
     a = Arena("1v1", 3, seed=1)
     for _ in range(5):

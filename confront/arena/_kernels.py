@@ -618,10 +618,18 @@ def _add_hit_robot(rf, b, i, j, bearing, fault, energy):
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
-def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
-    """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200."""
+def _perform_scan(rf, rb, bi, scanned, scan_time, scan_order, perm_r, last, b, i, mode):
+    """RobotPeer.performScan: radar pie from last to current radar heading, radius 1200.
+
+    The engine hands each scanner its own random robot list (Battle.updateRobots:
+    ``performScan(getRobotsAtRandom())``) and queues the ScannedRobotEvents in that order; where two scans'
+    distances differ by under 1 px (ScannedRobotEvent.compareTo) that order decides which the robot handles
+    first. ``scan_order[b, i]`` keeps it (built only when two or more robots were scanned; index order else)."""
     n = rf.shape[2]
-    bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)  # scan order changes nothing
+    rng0 = bi[b, RNG]
+    bi[b, RNG] = skip_shuffle(rng0, n, mode)
+    for q in range(n):
+        scan_order[b, i, q] = q
     if not rb[b, ALIVE, i]:
         return
     rb[b, TRWG, i] = False
@@ -657,6 +665,14 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, i, mode):
             if hit:
                 scanned[b, i, j] = True
                 scan_time[b, i, j] = bi[b, TIME]
+        hits = 0
+        for j in range(n):
+            if scanned[b, i, j]:
+                hits += 1
+        if hits >= 2 and mode == 0:
+            shuffle_into(rng0, perm_r, n, mode)
+            for q in range(n):
+                scan_order[b, i, q] = perm_r[q]
     rb[b, TRWG, i] = (last[b, 0, i] == last[b, 1, i]) and (rf[b, GH, i] == rf[b, RH, i])
 
 
@@ -678,7 +694,7 @@ def _clear_events(b, i, rb, ri, scanned, rf):
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
-def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
                  placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order):
     """One Robocode turn of battle b (Battle.runTurn)."""
     n = rf.shape[2]
@@ -744,9 +760,11 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
         order[q] = perm_d[q]
     for q in range(n):
         _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last, b, np.int64(order[q]), zap, params)
-    bi[b, RNG] = skip_shuffle(bi[b, RNG], n, mode)
+    bi[b, RNG] = shuffle_into(bi[b, RNG], perm_d, n, mode)  # the scanners' order: each draws its own list
     for q in range(n):
-        _perform_scan(rf, rb, bi, scanned, scan_time, perm_r, last, b, q, mode)
+        order[q] = perm_d[q]
+    for q in range(n):
+        _perform_scan(rf, rb, bi, scanned, scan_time, scan_order, perm_r, last, b, np.int64(order[q]), mode)
     # 4. deaths: placements and +50 survival to every living robot of another team
     nd = np.int64(dead[n])
     bi[b, RNG] = skip_shuffle(bi[b, RNG], nd, mode)  # placements do not depend on this order
@@ -844,16 +862,16 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+def step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
                    placements, placements_total, cmd, params, scratch_i, scratch_f, n, k):
     """_step_battle with battle b's rows of the scratch arrays."""
-    _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+    _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
                  placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
                  scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4])
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
-def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
                placements, placements_total, cmd, params, scratch_i, scratch_f):
     """Advance battles b0 .. b1-1 that are not done by one turn."""
     n = rf.shape[2]
@@ -861,7 +879,7 @@ def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledge
     for b in range(b0, b1):
         if bb[b, DONE]:
             continue
-        step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+        step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
                        placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
 
 

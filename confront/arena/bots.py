@@ -450,8 +450,11 @@ def _before(mem, b, i, k, m):
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-             ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, hb, has_hr):
-    """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns."""
+             ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, hb, has_hr, scan_order):
+    """Queue the last turn's events, then drop those older than MAX_EVENT_STACK turns.
+
+    The scans in the order of the robot's own random list of that turn (``scan_order``, the arena's): where
+    two distances differ by under 1 px, the one first in that list is handled first."""
     n = x.shape[1]
     if has_hr:  # one HitRobotEvent per collision, in the engine's order (RobotPeer.checkRobotCollision)
         for k in range(min(int(hr[b, 0, i]), HIT_ROBOT_SLOTS)):
@@ -471,7 +474,9 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
         # the event carries the bullet's own heading (Bullet.getHeadingRadians; BulletPeer's heading), not
         # bearing + body heading - pi, which can be an ulp off
         _add_event(mem, b, i, P_BULLET, -1.0, ev_hitby_bearing[b, i], 0.0, 0.0, ev_hitby_heading[b, i])
-    for j2 in range(n):
+    listed = n < 2 or scan_order[b, i, 0] != scan_order[b, i, 1]  # a state saved before scan_order: zeros
+    for q in range(n):
+        j2 = int(scan_order[b, i, q]) if listed else q
         if scanned[b, i, j2] and alive[b, j2]:
             dx = x[b, j2] - x[b, i]
             dy = y[b, j2] - y[b, i]
@@ -662,7 +667,8 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
-                 ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hr, hb, has_hr, heat):
+                 ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hr, hb, has_hr, heat,
+                 scan_order):
     """One decision of battle b's scripted robots (their robot time between two turns).
 
     Each robot resumes inside the execute() of its running blocking call: EventManager.processEvents first
@@ -693,7 +699,7 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
         rem[2] = gun_rem[b, i]
         rem[3] = radar_rem[b, i]
         _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
-                 ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, hb, has_hr)
+                 ev_hitby, ev_hitby_bearing, ev_hitby_heading, hr, hb, has_hr, scan_order)
         lv = _top_level(mem, b, i)
         process = True
         for _ in range(48):
@@ -758,18 +764,19 @@ def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, 
 def bots_step(kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
               assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
               ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots, hit_by_bullets,
-              heat):
+              heat, scan_order):
     """One decision of every scripted robot (their robot time between two turns).
 
     ``hit_robots``: the arena's per-collision HitRobot rows (``rf[:, EVROBN:EVROBN + 1 + 4 * HIT_ROBOT_SLOTS]``);
     ``hit_by_bullets``: its per-bullet HitByBullet rows (``rf[:, EVBULN:EVBULN + 1 + 2 * HIT_BY_BULLET_SLOTS]``);
-    ``heat``: the gun heats (TrackFire reads them). One call signature only: each variant is a compile.
+    ``heat``: the gun heats (TrackFire reads them); ``scan_order``: each robot's scan list of the last turn in
+    the engine's random order (the arena's ``scan_order``). One call signature only: each variant is a compile.
     """
     for b in range(x.shape[0]):
         _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem,
                      radar_rem, maxv, assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault,
                      ev_hitby, ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hit_robots,
-                     hit_by_bullets, True, heat)
+                     hit_by_bullets, True, heat, scan_order)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
@@ -783,7 +790,8 @@ def _clear_memory(mem, b):
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
-def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger,
+def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order,
+               ledger,
                score, score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, fixed,
                has_fixed, width, height, rem):
     """``turns`` turns of battles b0..b1-1, each as ``commands``, ``Arena.step``, ``Arena.reset(done)``.
@@ -815,9 +823,10 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
                     cmd[b, i, 4] = 0.0
             _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist, body, gun, radar, maxv, assist,
                          scan_req, scanned, ev_wall, ev_robot, ev_robb, ev_fault, ev_hitby, ev_bulb, ev_bulh, ev_died,
-                         width, height, cmd, rem, hr, hb, True, heat)
+                         width, height, cmd, rem, hr, hb, True, heat, scan_order)
             if not bb[b, K.DONE]:
-                K.step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+                K.step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
+                                 score_total,
                                  placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
             for i in range(n):
                 total += 1 if rb[b, K.ALIVE, i] else 0
@@ -945,7 +954,7 @@ class ScriptedBots:
                 s.ev_hit_by_bullet_heading[r], s.ev_died[r],
                 float(self.arena.scenario.width), float(self.arena.scenario.height)), np.zeros(4),
                 (s.packed["rf"][r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS],
-                 s.packed["rf"][r, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS], s.gun_heat[r])))
+                 s.packed["rf"][r, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS], s.gun_heat[r], s.scan_order[r])))
 
     def _run(self, k: int, cmd: np.ndarray) -> None:
         """bots_step on battle chunk k."""

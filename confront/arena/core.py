@@ -45,7 +45,9 @@ own heading, as HitByBulletEvent.getHeading() reports it); every bullet's in the
 
 Radar ``(B, R, R)``: ``scanned[b, i, j]`` robot i's radar swept robot j this turn (Robocode's
 ScannedRobotEvent; its data equals the true end-of-turn state of j, so readers use ``x[b, j]`` etc.),
-``scan_time[b, i, j]`` the turn of the last such scan this round (-1 never).
+``scan_time[b, i, j]`` the turn of the last such scan this round (-1 never), ``scan_order[b, i]`` robot i's
+robot list of its last scan in the engine's random order (``performScan(getRobotsAtRandom())``: the order its
+ScannedRobotEvents were queued in; index order where fewer than two robots were scanned).
 
 Scores: ``score`` ``(B, R, 6)`` this round and ``score_total`` summed over decided rounds (copied at
 the deciding turn, as Robocode does), parts in :data:`confront.arena.state.SCORE_PARTS` order
@@ -153,8 +155,8 @@ class Arena:
         self._scratch_f = np.zeros((b, 3, r), dtype=np.float64)
         p = self.state.packed
         self._args = ((p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
-                       p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
-                       p["placements_total"]), (self.params, self._scratch_i, self._scratch_f))
+                       p["scan_time"], p["scan_order"], p["damage_ledger"], p["score"], p["score_total"],
+                       p["placements"], p["placements_total"]), (self.params, self._scratch_i, self._scratch_f))
         self.seed(seed)
         self.reset()
 
@@ -254,6 +256,9 @@ class Arena:
                     last = np.asarray(d[f"ev_hit_by_bullet_{f}"], dtype=np.float64)
                     rows[f"ev_hit_by_bullet_{k}_{f}"] = last.copy() if k == 0 else np.zeros_like(last)
             d = dict(d, **rows)
+        if "scan_order" not in d and "scanned" in d:  # saved before scan_order: the scans in index order
+            d = dict(d, scan_order=np.broadcast_to(np.arange(self.n_robots, dtype=np.int32),
+                                                   np.asarray(d["scanned"]).shape))
         for name in FIELDS:
             if name not in d:
                 raise ValueError(f"state dict lacks {name!r}")

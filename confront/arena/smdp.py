@@ -206,8 +206,8 @@ class TeamBattleEnv:
         # each thread needs its own bots scratch (the bots' ``rem``)
         self._rems = [np.zeros(4) for _ in self._ranges]
         self._kargs = (p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
-                       p["scan_time"], p["damage_ledger"], p["score"], p["score_total"], p["placements"],
-                       p["placements_total"], self._cmd, a.params, a._scratch_i, a._scratch_f,
+                       p["scan_time"], p["scan_order"], p["damage_ledger"], p["score"], p["score_total"],
+                       p["placements"], p["placements_total"], self._cmd, a.params, a._scratch_i, a._scratch_f,
                        self.bots.mem if self.bots is not None else np.zeros((b, r, 1)))
         self._kargs_end = (self.field[0], self.field[1], self._turn_buf)
         # robots whose tank view is computed (a pool sets its caller-driven robots: nobody reads a bot's view)

@@ -94,7 +94,7 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
 
 
 @njit(cache=True, nogil=True)
-def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, width, height, cmd, rem):
+def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem):
     """The scripted bots' decisions of battles b0..b1-1 (bots.bots_step on the arena's packed arrays)."""
     r = slice(b0, b1)
     bots_step(kinds, mem[r], rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.GH], rf[r, K.RH], rf[r, K.E],
@@ -103,12 +103,12 @@ def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, width, height, cmd, rem
               rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
               rf[r, K.EVBULB], rf[r, K.EVBULH], rb[r, K.EVDIED], width, height, cmd[r], rem,
               rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS],
-              rf[r, K.HEAT])
+              rf[r, K.HEAT], scan_order[r])
 
 
 @njit(cache=True, nogil=True)
 def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
-                rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total, placements,
+                rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
                 placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
                 rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
                 view_mask, paper_mask):
@@ -177,7 +177,7 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
             t1 = t
             break
         if has_bots:
-            _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, width, height, cmd, rem)
+            _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem)
         if k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
             for b in range(b0, b1):
                 mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
@@ -188,7 +188,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                     if margin:
                         before[b - b0, i] = score[b, i].sum()
         # one Robocode turn of these battles (what Arena.step runs)
-        K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, score_total,
+        K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
+                     score_total,
                      placements, placements_total, cmd, params, scratch_i, scratch_f)
         for b in range(b0, b1):
             remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],

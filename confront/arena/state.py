@@ -67,6 +67,7 @@ GROUPS: dict[str, tuple[tuple[str, ...], str, type]] = {
 SINGLES: dict[str, tuple[str, type]] = {
     "scanned": ("BRR", np.bool_),
     "scan_time": ("BRR", np.int32),
+    "scan_order": ("BRR", np.int32),
     "damage_ledger": ("BRR", np.float64),
     "score": ("BRS", np.float64),
     "score_total": ("BRS", np.float64),

@@ -33,6 +33,7 @@ FIXES = {
     "sample_trackfire_ramfire_team": "Java's atan2 (fdlibm) for scan bearings: TrackFire's bearingFromGun == 0 test",
     "sample_fire_hitby_heading": "HitByBulletEvent carries the bullet's own heading (Fire's turn in onHitByBullet)",
     "sample_hitby_per_bullet": "one HitByBulletEvent per bullet, in the engine's bullet order (Fire hit twice)",
+    "sample_scan_order": "scans under 1 px apart come in the scanner's own random robot list's order (MyFirstLeader)",
 }
 
 

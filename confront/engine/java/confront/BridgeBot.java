@@ -663,6 +663,9 @@ public class BridgeBot extends TeamRobot {
                 // takes too long in its handlers, and the end line must be out by then
                 send("E " + getRoundNum() + " " + getTime() + " " + how + " " + getEnergy() + " " + rttN + " "
                         + rttSum / 1000 + " " + rttSlow + " " + turnsPlayed + " " + workNanos / 1000 + "\t" + history);
+                // a FIN right behind the end line: if the engine stops this thread before the answer below is
+                // read, closing with it unread sends a reset, which can make the server lose a line not yet read
+                socket.shutdownOutput();
                 if (pending) {
                     in.readLine();  // the answer to a request sent ahead (lead): closing with it unread resets
                     pending = false;

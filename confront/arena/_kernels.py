@@ -624,12 +624,11 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, scan_order, perm_r, last, b, i
     The engine hands each scanner its own random robot list (Battle.updateRobots:
     ``performScan(getRobotsAtRandom())``) and queues the ScannedRobotEvents in that order; where two scans'
     distances differ by under 1 px (ScannedRobotEvent.compareTo) that order decides which the robot handles
-    first. ``scan_order[b, i]`` keeps it (built only when two or more robots were scanned; index order else)."""
+    first. ``scan_order[b, i]`` keeps it, written only when two or more robots were scanned (with one the order
+    cannot matter; index order from the allocation on)."""
     n = rf.shape[2]
     rng0 = bi[b, RNG]
     bi[b, RNG] = skip_shuffle(rng0, n, mode)
-    for q in range(n):
-        scan_order[b, i, q] = q
     if not rb[b, ALIVE, i]:
         return
     rb[b, TRWG, i] = False

@@ -474,9 +474,8 @@ def _enqueue(mem, b, i, x, y, h, energy, alive, team, scanned, ev_wall, ev_robot
         # the event carries the bullet's own heading (Bullet.getHeadingRadians; BulletPeer's heading), not
         # bearing + body heading - pi, which can be an ulp off
         _add_event(mem, b, i, P_BULLET, -1.0, ev_hitby_bearing[b, i], 0.0, 0.0, ev_hitby_heading[b, i])
-    listed = n < 2 or scan_order[b, i, 0] != scan_order[b, i, 1]  # a state saved before scan_order: zeros
     for q in range(n):
-        j2 = int(scan_order[b, i, q]) if listed else q
+        j2 = int(scan_order[b, i, q])
         if scanned[b, i, j2] and alive[b, j2]:
             dx = x[b, j2] - x[b, i]
             dy = y[b, j2] - y[b, i]

@@ -43,8 +43,8 @@ from .smdp import SMDPConfig, StepResult, TeamBattleEnv
 from .state import SCORE_PARTS
 from .tank import TankSpace, feature_names
 
-__all__ = ["BattleEnv", "AgentDriver", "make_observation_space", "make_config", "make_spaces", "action_indices",
-           "tank_observation_space", "OtherPolicy", "ENV_ID", "VIEWS"]
+__all__ = ["BattleEnv", "AgentDriver", "make_observation_space", "make_config", "make_spaces", "agent_obs",
+           "action_indices", "tank_observation_space", "OtherPolicy", "ENV_ID", "VIEWS"]
 
 ENV_ID = "confront/Battle-v0"
 VIEWS = {"paper": 10, "tank": 5}  # what a tank sees and chooses -> its default T (turns per step)
@@ -83,9 +83,8 @@ def tank_observation_space(space: TankSpace) -> spaces.Box:
     """Box of the tank view (float32): energies / 100 bounded by 10 (1000 energy), sines, cosines and velocities
     by +-1, everything else (wall distances, heat, fractions, distances, ages, drops, flags) by [0, 1]."""
     names = feature_names(space.enemy_slots, space.mate_slots)
-    low = np.array([-1.0 if n.startswith(("sin", "cos")) or n.split("_")[-1] in ("heading", "bearing", "velocity",
-                                                                                   "lateral", "advancing")
-                    else 0.0 for n in names], dtype=np.float32)
+    signed = ("heading", "bearing", "velocity", "lateral", "advancing")  # sin_/cos_heading, *_bearing, ...
+    low = np.array([-1.0 if n.split("_")[-1] in signed else 0.0 for n in names], dtype=np.float32)
     high = np.array([10.0 if n.endswith("energy") else 1.0 for n in names], dtype=np.float32)
     return spaces.Box(low, high, dtype=np.float32)
 
@@ -98,9 +97,20 @@ def make_spaces(cfg: SMDPConfig) -> tuple[spaces.Space, spaces.Space]:
     return tank_observation_space(cfg.tank), spaces.MultiDiscrete(np.array(cfg.tank.dims, dtype=np.int64))
 
 
+def agent_obs(cfg: SMDPConfig, disc: Any, feats: np.ndarray) -> dict[str, Any] | np.ndarray:
+    """What the spaces of :func:`make_spaces` hold for the rows given (one tank: ``disc`` a scalar, ``feats``
+    (F,); or several): a copy of the tank view, or the paper's Dict of state and features."""
+    if cfg.tank is not None:
+        return np.array(feats, copy=True)
+    return {"state": int(disc) if np.ndim(disc) == 0 else np.array(disc, copy=True), "features": feats.copy()}
+
+
 def action_indices(cfg: SMDPConfig, actions: Any, n: int) -> np.ndarray:
     """(n,) joint action indices from ``n`` actions of the space :func:`make_spaces` gives: integers (paper), or
     (n, heads) head indices (tank view, ``np.ravel_multi_index`` over ``tank.dims``); a clear ValueError else."""
+    if cfg.tank is None and n == 1 and isinstance(actions, int | np.integer) and not isinstance(actions, bool) \
+            and 0 <= actions < cfg.n_actions:  # the single env's usual call, without array work
+        return np.array([actions], dtype=np.int64)
     a = np.asarray(actions)
     whole = a.dtype.kind in "iufb" and bool(np.all(np.isfinite(a))) and bool(np.all(a == np.round(a)))
     if cfg.tank is None:
@@ -188,9 +198,7 @@ class BattleEnv(gym.Env):
         return self._driver.env
 
     def _obs(self, disc: np.ndarray, feats: np.ndarray) -> dict[str, Any] | np.ndarray:
-        if self.config.tank is not None:
-            return feats[0, 0].copy()
-        return {"state": int(disc[0, 0]), "features": feats[0, 0].copy()}
+        return agent_obs(self.config, disc[0, 0], feats[0, 0])
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[dict[str, Any] | np.ndarray, dict[str, Any]]:

@@ -20,7 +20,7 @@ from gymnasium import spaces
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from .gym_env import AgentDriver, OtherPolicy, action_indices, make_config, make_spaces
+from .gym_env import AgentDriver, OtherPolicy, action_indices, agent_obs, make_config, make_spaces
 from .render import draw_frame
 from .scenarios import Scenario, get_scenario
 from .smdp import SMDPConfig
@@ -65,10 +65,7 @@ class TeamParallelEnv(ParallelEnv):
         return self._act_spaces[agent]
 
     def _obs(self, disc: np.ndarray, feats: np.ndarray, agents: list[str]) -> dict[str, Any]:
-        if self.config.tank is not None:
-            return {a: feats[0, self._index[a]].copy() for a in agents}
-        return {a: {"state": int(disc[0, self._index[a]]), "features": feats[0, self._index[a]].copy()}
-                for a in agents}
+        return {a: agent_obs(self.config, disc[0, self._index[a]], feats[0, self._index[a]]) for a in agents}
 
     def reset(self, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[dict[str, Any], dict[str, Any]]:

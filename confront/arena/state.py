@@ -141,6 +141,7 @@ def allocate(scenario: Scenario, n_battles: int) -> ArenaState:
         arrays[name] = arr
     for name, v in DEFAULTS.items():
         arrays[name][...] = v
+    arrays["scan_order"][...] = np.arange(r, dtype=np.int32)  # index order until a scanner's list is drawn
     teams = np.asarray(scenario.team_ids(), dtype=np.int32)
     arrays["team"][:] = teams
     arrays["is_advanced"][:] = scenario.advanced

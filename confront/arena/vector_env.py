@@ -16,7 +16,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 
-from .gym_env import AgentDriver, OtherPolicy, action_indices, make_config, make_spaces
+from .gym_env import AgentDriver, OtherPolicy, action_indices, agent_obs, make_config, make_spaces
 from .scenarios import Scenario
 from .smdp import SMDPConfig
 from .state import SCORE_PARTS
@@ -50,14 +50,7 @@ class BattleVectorEnv(VectorEnv):
         self._np_random, _ = gym.utils.seeding.np_random(seed)
 
     def _obs(self, disc: np.ndarray, feats: np.ndarray) -> dict[str, np.ndarray] | np.ndarray:
-        if self.config.tank is not None:
-            return feats[:, 0].copy()
-        return {"state": disc[:, 0].copy(), "features": feats[:, 0].copy()}
-
-    def _single(self, obs: dict[str, np.ndarray] | np.ndarray, i: int) -> dict[str, Any] | np.ndarray:
-        if isinstance(obs, np.ndarray):
-            return obs[i]
-        return {"state": int(obs["state"][i]), "features": obs["features"][i]}
+        return agent_obs(self.config, disc[:, 0], feats[:, 0])
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
               ) -> tuple[dict[str, np.ndarray] | np.ndarray, dict[str, Any]]:
@@ -86,7 +79,7 @@ class BattleVectorEnv(VectorEnv):
         if ended.any():
             final = np.empty(self.num_envs, dtype=object)
             for i in np.flatnonzero(ended):
-                final[i] = self._single(obs, i)
+                final[i] = agent_obs(self.config, res.discrete[i, 0], res.features[i, 0])
             info["final_obs"] = final
             info["_final_obs"] = ended
             info["team_score"] = drv.team_score()

@@ -170,7 +170,9 @@ def test_acting_robot_plays_the_exported_robots_battle(install, tmp_path) -> Non
                       extra_robots=[export_robot(policy, tmp_path / "robots")])
     assert res.ok, (res.failures, res.server_errors)
     assert checked.differ == [] and res.decisions == len(checked.seen) > 100
-    assert all(o.action >= 0 and (o.turn - 1) % 5 == 0 for o in checked.seen)
+    # decisions in turns 1, 6, 11, ...; a skipped turn (a loaded machine) makes one up at a later turn
+    late = bool(res.run.skipped_turns)
+    assert all(o.action >= 0 and ((o.turn - 1) % 5 == 0 or late) for o in checked.seen)
     assert res.rtt_mean_us > 0 and 0 <= res.behind <= res.decisions
     if not res.run.skipped_turns and not java.skipped_turns:  # a skipped turn changes the rest of a battle
         assert res.run.round_turns == java.round_turns

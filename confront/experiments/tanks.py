@@ -342,18 +342,20 @@ class TankTrainer:
                       active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
         t_env = 0.0
         for k in range(s):
-            joint, heads, logp, value = self.ppo.act(self.obs, crit)
+            joint, heads, logp, _ = self.ppo.act(self.obs)
             te = time.perf_counter()
             st: PoolStep = pool.step(joint)
             t_env += time.perf_counter() - te
-            buf.obs[k], buf.critic[k], buf.heads[k], buf.logp[k], buf.value[k] = self.obs, crit, heads, logp, value
+            buf.obs[k], buf.critic[k], buf.heads[k], buf.logp[k] = self.obs, crit, heads, logp
             buf.reward[k], buf.done[k], buf.active[k] = st.reward * c.reward_scale, st.done, st.active
             self.decisions += int(st.active.sum())
             for r in st.rounds:
                 self.rows.append({"round": len(self.rows) + 1, **r, "decisions": self.decisions})
             self.obs = st.obs
             crit = self._critic(self.obs)
-        buf.last_value = self.ppo.values(crit)
+        # the values of the whole rollout in one product (the weights acted with; cheaper than one per step)
+        values = self.ppo.values(np.concatenate([buf.critic.reshape(s * n, -1), crit]), threads=c.threads)
+        buf.value[...], buf.last_value = values[:s * n].reshape(s, n), values[s * n:]
         return buf, t_env
 
     def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:

@@ -317,9 +317,16 @@ class PPO:
         return np.ravel_multi_index(tuple(hn.T), self.dims), hn, logp.numpy(), value
 
     @torch.no_grad()
-    def values(self, critic_in: np.ndarray) -> np.ndarray:
-        """V of (N, C) critic inputs."""
-        return self.acting.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
+    def values(self, critic_in: np.ndarray, threads: int | None = None) -> np.ndarray:
+        """V of (N, C) critic inputs (on ``threads`` torch threads for this call, e.g. a whole rollout's)."""
+        x = torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))
+        if threads is None or threads == self._act_threads:
+            return self.acting.value(x).numpy()
+        torch.set_num_threads(threads)
+        try:
+            return self.acting.value(x).numpy()
+        finally:
+            torch.set_num_threads(self._act_threads)
 
     def set_progress(self, progress: float) -> None:
         """Tell the learner the fraction of the run done (0..1); with ``anneal_lr`` the next updates step by

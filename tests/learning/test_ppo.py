@@ -234,14 +234,18 @@ def test_learning_rate_anneals_linearly_to_zero() -> None:
         np.testing.assert_array_equal(v, ppo.state_dict()[k], err_msg=k)
 
 
-@pytest.mark.parametrize(("given", "want"), [({}, "3000"), ({"OMP_WAIT_POLICY": "ACTIVE"}, "unset"),
-                                           ({"GOMP_SPINCOUNT": "10"}, "10")])
-def test_openmp_workers_spin_briefly_unless_the_user_says_otherwise(given: dict[str, str], want: str) -> None:
+@pytest.mark.parametrize(("var", "given", "want"), [
+    ("GOMP_SPINCOUNT", {}, "3000"), ("GOMP_SPINCOUNT", {"OMP_WAIT_POLICY": "ACTIVE"}, "unset"),
+    ("GOMP_SPINCOUNT", {"GOMP_SPINCOUNT": "10"}, "10"),
+    ("OPENBLAS_THREAD_TIMEOUT", {}, "4"), ("OPENBLAS_THREAD_TIMEOUT", {"OPENBLAS_THREAD_TIMEOUT": "20"}, "20")])
+def test_thread_pools_spin_briefly_unless_the_user_says_otherwise(var: str, given: dict[str, str], want: str) -> None:
+    """torch's OpenMP workers and NumPy's OpenBLAS workers stop busy-waiting soon (confront/__init__.py)."""
     import os
     import subprocess
     import sys
 
-    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")} | given
-    code = "import confront, os; print(os.environ.get('GOMP_SPINCOUNT', 'unset'))"
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "OPENBLAS_THREAD_TIMEOUT")} | given
+    code = f"import confront, os; print(os.environ.get({var!r}, 'unset'))"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == want

@@ -142,13 +142,6 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
     return shares
 
 
-def _at_baseline_step(policy: Any, exp: ExperimentConfig) -> Any:
-    """An ExportedPolicy with the baselines' observation and step length (``exp``'s)."""
-    from confront.experiments.episodes import smdp_config
-
-    return replace(policy, observation=smdp_config(exp).observation, step_turns=exp.arena.decision_turns)
-
-
 def engine_policy(method: str, seed: int, work: Path, td_name: str) -> Any:
     """``method`` at ``seed`` as the engine's PolicyBot (an ExportedPolicy at the baselines' step length), trained
     by :func:`_baseline_policy` where it is not yet in ``work``: DMNN (FLM) greedy (``ExportedPolicy.from_learner``),
@@ -157,8 +150,9 @@ def engine_policy(method: str, seed: int, work: Path, td_name: str) -> Any:
     from confront.experiments.episodes import smdp_config
 
     exp = baseline_experiment(BaselinesConfig(), seed, TRAIN_ROUNDS)
+    observation, step_turns = smdp_config(exp).observation, exp.arena.decision_turns
     if method == RANDOM_METHOD:
-        return _at_baseline_step(paper_move_robot(exp, "random"), exp)
+        return replace(paper_move_robot(exp, "random"), observation=observation, step_turns=step_turns)
     if method == SB3_PPO:
         folder = work / "sb3-ppo" / f"seed-{seed}"
         info = json.loads((folder / "train.json").read_text()) if (folder / "train.json").is_file() else {}
@@ -167,8 +161,7 @@ def engine_policy(method: str, seed: int, work: Path, td_name: str) -> Any:
             info = json.loads((folder / "train.json").read_text())
         with np.load(folder / "policy.npz", allow_pickle=False) as z:
             state = {k: z[k] for k in z.files}
-        return sb3_exported_policy(state, info["activation"], smdp_config(exp).observation,
-                                   exp.arena.decision_turns)
+        return sb3_exported_policy(state, info["activation"], observation, step_turns)
     learner, exp = _baseline_policy(method, seed, work, td_name)
     return exported_policy(learner, exp)
 

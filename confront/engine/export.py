@@ -172,7 +172,10 @@ class ExportedPolicy:
 
     def values(self, obs: Observation) -> np.ndarray:
         """Action values of the four moves for one observation."""
-        state, feats = self.state_and_features(obs)
+        return self.values_of(*self.state_and_features(obs))
+
+    def values_of(self, state: int, feats: np.ndarray) -> np.ndarray:
+        """Action values of the four moves for the paper's discrete ``state`` and the continuous ``feats``."""
         if self.kind == "qtable":
             assert self.q is not None
             return np.asarray(self.q[state], dtype=np.float64)
@@ -272,7 +275,8 @@ def policy_data_source(text: str, chunk: int = 30000, name: str = "PolicyData") 
             + body + f"\n    }};\n\n    private {name}() {{\n    }}\n}}\n")
 
 
-def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall | None = None) -> Path:
+def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall | None = None,
+                 version: str = "1.0") -> Path:
     """Write the standalone robot ``confront.PolicyBot`` with ``policy``: a robots folder or a ``.jar``.
 
     A folder gets ``confront/PolicyBot.class``, ``PolicyModel.class``, ``PolicyData.class`` (the policy
@@ -280,11 +284,11 @@ def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall
     and the Java sources; a jar holds the same files and can be dropped into Robocode's robots folder.
     """
     return write_robot(out, "PolicyBot", POLICY_CLASSES, "PolicyData", "policy.txt", policy.to_text(),
-                       "A policy trained with confront (fuzzy RL), exported with its own inference", install)
+                       "A policy trained with confront (fuzzy RL), exported with its own inference", install, version)
 
 
 def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str, policy_file: str, text: str,
-                description: str, install: EngineInstall | None = None) -> Path:
+                description: str, install: EngineInstall | None = None, version: str = "1.0") -> Path:
     """A robot ``confront.<bot>`` as a robots folder or a ``.jar``: the project's compiled ``classes`` and their
     sources, ``<bot>.properties``, the policy ``text`` as ``policy_file`` and compiled into the class ``data``
     (string constants: the robot reads no file, in the engine's sandbox or from a jar)."""
@@ -300,7 +304,7 @@ def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str, 
             shutil.copy2(compiled / "confront" / f"{cls}.class", pkg / f"{cls}.class")
             shutil.copy2(src / f"{cls}.java", pkg / f"{cls}.java")
         (pkg / f"{bot}.properties").write_text(
-            f"robot.classname=confront.{bot}\nrobot.name={bot}\nrobot.version=1.0\n"
+            f"robot.classname=confront.{bot}\nrobot.name={bot}\nrobot.version={version}\n"
             f"robot.description={description}\nrobot.java.source.included=true\nrobocode.version=1.9.3.9\n"
         )
         (pkg / policy_file).write_text(text)

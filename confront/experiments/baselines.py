@@ -26,8 +26,9 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -50,7 +51,7 @@ except ImportError:  # the core install runs the scripted and paper methods only
     HAVE_SB3 = False
 
 __all__ = ["BaselinesConfig", "SharedTeamVecEnv", "SB3Policy", "baselines_outcome", "train_sb3",
-           "rank_table", "HAVE_SB3"]
+           "sb3_activation", "sb3_exported_policy", "rank_table", "HAVE_SB3"]
 
 SB3_METHODS = ("DQN", "PPO")
 DMNN_METHOD = "DMNN (FLM)"
@@ -263,6 +264,35 @@ class SB3Policy(Learner):
         if missing:
             raise ValueError(f"state_dict misses key {sorted(missing)[0]!r}")
         self.model.policy.load_state_dict({k: torch.as_tensor(state[k]) for k in own})
+
+
+SB3_ACTIVATIONS = {"Tanh": "tanh", "ReLU": "relu"}  # torch activations of an SB3 MLP -> ExportedPolicy's names
+
+
+def sb3_activation(model: Any) -> str:
+    """ExportedPolicy's name of the activation of an SB3 actor-critic model's MLP (``policy.activation_fn``)."""
+    name = model.policy.activation_fn.__name__
+    if name not in SB3_ACTIVATIONS:
+        raise ValueError(f"SB3 activation {name} has no exported twin; known: {', '.join(SB3_ACTIVATIONS)}")
+    return SB3_ACTIVATIONS[name]
+
+
+def sb3_exported_policy(state: Mapping[str, np.ndarray], activation: str, observation: Any, step_turns: int
+                        ) -> Any:
+    """An SB3 PPO policy network (:meth:`SB3Policy.state_dict`) as the engine's greedy MLP (an ExportedPolicy on
+    the features): the actor's layers ``mlp_extractor.policy_net.<i>``, each followed by ``activation``, then
+    ``action_net`` (the logits); the first maximum is SB3's deterministic action."""
+    from confront.engine.export import ExportedPolicy
+
+    idx = sorted(int(m.group(1)) for k in state if (m := re.fullmatch(r"mlp_extractor\.policy_net\.(\d+)\.weight", k)))
+    names = [f"mlp_extractor.policy_net.{i}" for i in idx] + ["action_net"]
+    missing = [f"{n}.{p}" for n in names for p in ("weight", "bias") if f"{n}.{p}" not in state]
+    if missing:
+        raise ValueError(f"not an SB3 actor-critic policy: {', '.join(missing)} missing")
+    return ExportedPolicy("mlp", weights=tuple(np.asarray(state[f"{n}.weight"], np.float64) for n in names),
+                          biases=tuple(np.asarray(state[f"{n}.bias"], np.float64) for n in names),
+                          hidden_activation=activation, output_activation="linear", observation=observation,
+                          step_turns=step_turns)
 
 
 # -- one (method, seed) ------------------------------------------------------------------------------------------

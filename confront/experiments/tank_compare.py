@@ -19,6 +19,16 @@ and ``PPO tanks - method`` paired over seeds (BCa interval, one-sided sign-flip 
 
 Writes ``compare.json`` and ``compare.md`` into ``--out``. Trained baselines and per-(method, seed) results are
 cached under ``--work`` (default ``runs/tank-compare``), so an interrupted comparison resumes.
+
+    python -m confront.experiments.tank_compare --from-report docs/results/tanks/results.json --engine robocode \
+        --out docs/results/tanks [--rounds 30] [--engine-seed 1]
+
+``--engine robocode``: the same comparison in Robocode 1.9.3.9, paired over the report's engine runs (``seedK``:
+training seed K). PPO tanks' share per seed and entry is the mean of the report's engine battles (the exported
+TankBot); the baselines are trained as above and play as exported PolicyBots (:func:`engine_policy`), one battle
+of ``--rounds`` rounds (engine seed ``--engine-seed``) per entry, against the sample robots or the seed's TD team
+(exported PolicyBots, greedy with random ties, at the baselines' step length). Writes ``compare-engine.json`` and
+``compare-engine.md``; each battle is cached under ``--work``/engine as it ends.
 """
 
 from __future__ import annotations
@@ -26,6 +36,7 @@ from __future__ import annotations
 import argparse
 import io
 import json
+import re
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -41,21 +52,25 @@ from confront.experiments.baselines import (
     SB3Policy,
     baseline_experiment,
     pooled_ratio,
+    sb3_activation,
+    sb3_exported_policy,
     train_sb3,
 )
-from confront.experiments.evaluate import sim_evaluate
+from confront.experiments.evaluate import exported_policy, sim_evaluate
 from confront.experiments.jobs import Job, run_jobs
 from confront.experiments.spec import ExperimentConfig, config_from_dict, load_toml
 from confront.experiments.stats import paired_comparison
-from confront.experiments.tanks import evaluate_tanks, load_tank_model
+from confront.experiments.tanks import evaluate_tanks, load_tank_model, paper_move_robot
 from confront.learning.base import Learner
 
-__all__ = ["OURS", "METHODS", "compare_entries", "method_shares", "compare", "write_markdown"]
+__all__ = ["OURS", "METHODS", "compare_entries", "method_shares", "compare", "engine_policy",
+           "engine_method_shares", "compare_engine", "write_markdown"]
 
 OURS = "PPO tanks"
 SB3_PPO = "PPO (SB3)"
 METHODS = (DMNN_METHOD, SB3_PPO, RANDOM_METHOD)
 TRAIN_ROUNDS = 500  # the baselines' budget (the paper's)
+ENGINE_SEED = 1  # the baselines' engine battle (tank_report played PPO tanks' at engine seeds 1, 2, 3)
 
 
 def compare_entries(opponents: tuple[str, ...]) -> list[str]:
@@ -92,16 +107,22 @@ def _baseline_policy(method: str, seed: int, work: Path, td_name: str) -> tuple[
         buf = io.BytesIO()
         np.savez(buf, **policy.state_dict())
         ck.write_atomic(folder / "policy.npz", buf.getvalue())
-        ck.write_atomic(folder / "train.json", json.dumps(info, indent=1).encode())
+        ck.write_atomic(folder / "train.json", json.dumps({**info, "activation": sb3_activation(model)},
+                                                          indent=1).encode())
         return policy, exp
     raise ValueError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+
+
+def _result_file(method: str, seed: int) -> str:
+    """The cache file name of a method's results at a seed."""
+    return f"{method.replace(' ', '_').replace('(', '').replace(')', '')}-seed-{seed}.json"
 
 
 def method_shares(method: str, seed: int, entries: list[str], td_model: str, rounds: int, work: Path
                   ) -> dict[str, float]:
     """Greedy share per entry of a baseline method at ``seed`` (cached in ``work``, with the TD team it trained
     against and faced: a cache made against another TD-team artefact is played again)."""
-    done = work / "results" / f"{method.replace(' ', '_').replace('(', '').replace(')', '')}-seed-{seed}.json"
+    done = work / "results" / _result_file(method, seed)
     td_name = Path(td_model).name  # the artefact's digest folder (its config and seed), not this machine's path
     if done.exists():
         cached = json.loads(done.read_text())
@@ -119,6 +140,72 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
     ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "td_team": td_name,
                                       "shares": shares}, indent=1).encode())
     return shares
+
+
+def engine_policy(method: str, seed: int, work: Path, td_name: str) -> Any:
+    """``method`` at ``seed`` as the engine's PolicyBot (an ExportedPolicy at the baselines' step length), trained
+    by :func:`_baseline_policy` where it is not yet in ``work``: DMNN (FLM) greedy (``ExportedPolicy.from_learner``),
+    SB3 PPO deterministic (:func:`sb3_exported_policy` of the kept ``policy.npz``), random moves as zero move
+    values with random ties (:func:`tanks.paper_move_robot`)."""
+    from confront.experiments.episodes import smdp_config
+
+    exp = baseline_experiment(BaselinesConfig(), seed, TRAIN_ROUNDS)
+    observation, step_turns = smdp_config(exp).observation, exp.arena.decision_turns
+    if method == RANDOM_METHOD:
+        return replace(paper_move_robot(exp, "random"), observation=observation, step_turns=step_turns)
+    if method == SB3_PPO:
+        folder = work / "sb3-ppo" / f"seed-{seed}"
+        info = json.loads((folder / "train.json").read_text()) if (folder / "train.json").is_file() else {}
+        if "activation" not in info or not (folder / "policy.npz").is_file():
+            _baseline_policy(method, seed, work, td_name)
+            info = json.loads((folder / "train.json").read_text())
+        with np.load(folder / "policy.npz", allow_pickle=False) as z:
+            state = {k: z[k] for k in z.files}
+        return sb3_exported_policy(state, info["activation"], observation, step_turns)
+    learner, exp = _baseline_policy(method, seed, work, td_name)
+    return exported_policy(learner, exp)
+
+
+def engine_method_shares(method: str, seed: int, entries: list[str], td_model: str, rounds: int, work: Path,
+                         engine_seed: int = ENGINE_SEED) -> dict[str, float]:
+    """Share per entry of a baseline method at ``seed`` in Robocode: :func:`engine_policy` for our side, one
+    battle of ``rounds`` rounds (engine seed ``engine_seed``) against the entry's sample robot(s) or the TD team
+    ``td_model`` (exported PolicyBots, greedy with random ties, at the baselines' step length). Each battle is
+    kept in ``work/engine`` as it ends; one of other rounds, engine seed or TD-team artefact is played again."""
+    from confront.engine.evaluate import evaluate_policy
+    from confront.experiments.episodes import load_model
+
+    path = work / "engine" / _result_file(method, seed)
+    key = {"method": method, "seed": seed, "rounds": rounds, "engine_seed": engine_seed,
+           "td_team": Path(td_model).name}
+    cached = json.loads(path.read_text()) if path.is_file() else {}
+    shares: dict[str, float] = dict(cached["shares"]) if all(cached.get(k) == v for k, v in key.items()) else {}
+    ours = theirs = None
+    for e in entries:
+        if e in shares:
+            continue
+        scen, _, opp = e.partition(":")
+        if ours is None:
+            ours = engine_policy(method, seed, work, key["td_team"])
+        if opp == "td" and theirs is None:
+            exp = baseline_experiment(BaselinesConfig(), seed, TRAIN_ROUNDS)
+            theirs = replace(exported_policy(load_model(td_model)[0], exp), ties="random")
+        shares[e] = evaluate_policy(ours, scen, opp, rounds=rounds, seed=engine_seed,
+                                    opponent_policy=theirs if opp == "td" else None)[1]
+        path.parent.mkdir(parents=True, exist_ok=True)
+        ck.write_atomic(path, json.dumps({**key, "shares": shares}, indent=1).encode())
+    return {e: shares[e] for e in entries}
+
+
+def _paired_tests(shares: dict[str, dict[str, list[float]]], entries: list[str]) -> dict[str, Any]:
+    """``PPO tanks - method`` per method and entry, paired over seeds (:func:`stats.paired_comparison`)."""
+    rng = np.random.default_rng(2026)
+    tests: dict[str, Any] = {m: {} for m in METHODS}
+    for m in METHODS:
+        for e in entries:
+            pc = paired_comparison(np.array(shares[OURS][e]), np.array(shares[m][e]), rng)
+            tests[m][e] = {"diff": pc.diff.mean, "lo": pc.diff.lo, "hi": pc.diff.hi, "p": pc.p}
+    return tests
 
 
 def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str, list[float]] | None = None,
@@ -145,12 +232,7 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str
             got = method_shares(m, cfg.train.seed, entries, str(td_path), rounds, work)
             for e in entries:
                 shares[m][e].append(got[e])
-    rng = np.random.default_rng(2026)
-    tests = {m: {} for m in METHODS}
-    for m in METHODS:
-        for e in entries:
-            pc = paired_comparison(np.array(shares[OURS][e]), np.array(shares[m][e]), rng)
-            tests[m][e] = {"diff": pc.diff.mean, "lo": pc.diff.lo, "hi": pc.diff.hi, "p": pc.p}
+    tests = _paired_tests(shares, entries)
     result = {"runs": [r.name for r in runs], "seeds": seeds, "rounds": rounds, "train_rounds": TRAIN_ROUNDS,
               "entries": entries, "shares": shares, "tests": tests, "play": play,
               "ours_battle_seed": "10000" if ours is not None else "10000 + seed"}
@@ -202,11 +284,72 @@ def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], 
     return result
 
 
-def write_markdown(result: dict[str, Any], out: Path) -> Path:
-    """``compare.md`` from ``compare.json``'s content."""
+def run_seed(name: str) -> int:
+    """The training seed a report's run is named by (``seedK``, as ``confront train -c tanks --set train.seed=K``
+    runs are named in the reports)."""
+    m = re.fullmatch(r"(?:.*\D)?seed-?(\d+)", name)
+    if m is None:
+        raise ValueError(f"run {name!r} does not name its training seed (seedK)")
+    return int(m.group(1))
+
+
+def compare_engine(results: Path, out: Path, rounds: int, work: Path, engine_seed: int = ENGINE_SEED
+                   ) -> dict[str, Any]:
+    """PPO tanks' Robocode shares from a tank_report ``results.json`` (per engine run, training seed K: the mean
+    of its battles) against every baseline at seed K in Robocode (:func:`engine_method_shares`), paired over
+    seeds; writes ``compare-engine.json`` and ``compare-engine.md``."""
+    from confront.experiments.episodes import td_team
+    from confront.experiments.spec import load_experiment
+
+    rep = json.loads(results.read_text())
+    runs = list(rep.get("engine_runs") or [])
+    if not runs:
+        raise ValueError(f"{results} has no engine runs (tank_report --engine --engine-runs K)")
+    seeds = [run_seed(r) for r in runs]
+    rows = {r["entry"]: r for r in rep["rows"]}
+    entries = compare_entries(tuple(rows))
+    ours: dict[str, list[float]] = {}
+    for e in entries:
+        battles = rows[e].get("engine_runs")
+        if not battles or len(battles) != len(runs):
+            raise ValueError(f"{results}: entry {e} lacks the engine battles of the runs {runs}")
+        ours[e] = [float(np.mean(b)) for b in battles]
+    shares: dict[str, dict[str, list[float]]] = {OURS: ours, **{m: {e: [] for e in entries} for m in METHODS}}
+    for seed in seeds:
+        _, td_path = td_team(load_experiment("tanks", (f"train.seed={seed}",)), 4)
+        for m in METHODS:
+            got = engine_method_shares(m, seed, entries, str(td_path), rounds, work, engine_seed)
+            for e in entries:
+                shares[m][e].append(got[e])
+    result = {"runs": runs, "seeds": seeds, "rounds": rounds, "train_rounds": TRAIN_ROUNDS, "entries": entries,
+              "shares": shares, "tests": _paired_tests(shares, entries),
+              "engine": {"engine_seed": engine_seed, "ours_rounds": rep["rounds"],
+                         "ours_battles": rep["engine_seeds"], "ours_play": rep.get("play", "greedy")}}
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "compare-engine.json").write_text(json.dumps(result, indent=1))
+    write_markdown(result, out, "compare-engine.md")
+    return result
+
+
+def write_markdown(result: dict[str, Any], out: Path, name: str = "compare.md") -> Path:
+    """``compare.md`` (or ``name``) from ``compare.json``'s (or ``compare-engine.json``'s) content."""
     seeds, entries, shares, tests = result["seeds"], result["entries"], result["shares"], result["tests"]
     n = len(seeds)
-    if result.get("test") == "welch":
+    paired = (f"Cells: mean share over the {n} seeds; `vs X`: PPO tanks - X, mean [95% BCa interval], one-sided "
+              "paired sign-flip permutation p (the smallest possible p with n seeds is 2^-n).")
+    if "engine" in result:
+        eng = result["engine"]
+        how = [f"Training seeds {', '.join(map(str, seeds))} (runs {', '.join(result['runs'])}; the baselines "
+               f"trained {result['train_rounds']} rounds against the same seed's TD team, as `confront reproduce "
+               "baselines`). Robocode 1.9.3.9, exported robots, no Python in the loop. PPO tanks: the exported "
+               f"TankBot, {eng['ours_play']}, the mean of {eng['ours_battles']} battles x {eng['ours_rounds']} "
+               f"rounds (engine seeds 1-{eng['ours_battles']}) per entry and seed, from the report's results.json. "
+               "The baselines: exported PolicyBots, greedy (random moves: a uniform draw each step), "
+               f"1 battle x {result['rounds']} rounds (engine seed {eng['engine_seed']}) per entry and seed. "
+               "The TD team: the seed's artefact as exported PolicyBots (greedy, random ties), at the step length "
+               "of the side it faces, as in the simulator comparison.",
+               paired]
+    elif result.get("test") == "welch":
         how = [f"PPO tanks: training seeds {', '.join(map(str, seeds))} (greedy shares of the report, battle seed "
                f"10000); the baselines: seeds {', '.join(map(str, result['base_seeds']))}, each trained "
                f"{result['train_rounds']} rounds against that seed's TD team, as `confront reproduce baselines` "
@@ -220,10 +363,10 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
                f"{result['train_rounds']} rounds against the same seed's TD team, as `confront reproduce "
                f"baselines`). Simulator, PPO tanks {play} (battle seed {result.get('ours_battle_seed', '10000 + seed')}"
                f"), the baselines greedy (battle seed 10000 + seed), {result['rounds']} rounds per entry and seed.",
-               f"Cells: mean share over the {n} seeds; `vs X`: PPO tanks - X, mean [95% BCa interval], one-sided "
-               "paired sign-flip permutation p (the smallest possible p with n seeds is 2^-n)."]
+               paired]
     lines = [
-        "# PPO tanks against the paper's method, SB3 PPO and random moves",
+        "# PPO tanks against the paper's method, SB3 PPO and random moves" + (" in Robocode" if "engine" in result
+                                                                              else ""),
         "",
         *how,
         "",
@@ -241,7 +384,7 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
         lines.append(f"| {e} | " + " | ".join(cells) + " | " + " | ".join(vs) + " |")
     lines += ["", "PPO tanks ahead at p < 0.05: " + "; ".join(f"{m} on {beats[m]} of {len(entries)} entries"
                                                           for m in METHODS) + ".", ""]
-    path = out / "compare.md"
+    path = out / name
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -255,9 +398,19 @@ def main() -> None:
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--rounds", type=int, default=100)
     ap.add_argument("--work", type=Path, default=Path("runs") / "tank-compare")
+    ap.add_argument("--engine", choices=("sim", "robocode"), default="sim",
+                    help="robocode: the baselines in the real engine against PPO tanks' engine shares of the report "
+                         "(needs --from-report), paired over its runs' training seeds")
+    ap.add_argument("--engine-seed", type=int, default=ENGINE_SEED, help="the baselines' engine battle seed")
     args = ap.parse_args()
     if args.rounds < 1:
         ap.error("--rounds must be at least 1")
+    if args.engine == "robocode":
+        if args.from_report is None or args.runs:
+            ap.error("--engine robocode takes --from-report (PPO tanks' engine shares), not RUNs")
+        compare_engine(args.from_report, args.out, args.rounds, args.work, args.engine_seed)
+        print((args.out / "compare-engine.md").read_text())
+        return
     if args.from_report is not None:
         compare_report(args.from_report, args.out, args.work, list(range(args.base_seeds)), args.rounds)
         print((args.out / "compare.md").read_text())

@@ -161,8 +161,15 @@ def test_java_inference_equals_the_simulator_on_its_observations(install, tmp_pa
         assert (math.isnan(gun) and math.isnan(jg)) or jg == pytest.approx(gun, abs=1e-12)
 
 
+def _tanh_mlp_policy(seed: int = 2) -> ExportedPolicy:
+    """An MLP with tanh hidden layers, as an SB3 network is exported."""
+    from dataclasses import replace
+
+    return replace(_mlp_policy(seed), hidden_activation="tanh")
+
+
 @pytest.mark.engine
-@pytest.mark.parametrize("make", [_q_policy, _mlp_policy], ids=["qtable", "mlp"])
+@pytest.mark.parametrize("make", [_q_policy, _mlp_policy, _tanh_mlp_policy], ids=["qtable", "mlp", "tanh-mlp"])
 def test_java_inference_equals_python_on_random_observations(install, tmp_path, make) -> None:
     policy = make()
     lines = _random_observations(400, seed=5)
@@ -208,6 +215,26 @@ def test_evaluate_exported_policy_in_engine(install) -> None:
     assert ours.firsts == 1 and ratio > 0.5  # SittingDuck never shoots
     with pytest.raises(ValueError, match="mode"):
         evaluate_policy(_q_policy(4), "1v1", "SittingDuck", mode="jpype")
+
+
+@pytest.mark.engine
+@pytest.mark.parametrize("scenario", ["1v1", "4v4"])
+def test_evaluate_against_an_exported_opponent_policy(install, scenario: str) -> None:
+    """Both sides exported PolicyBots (one class in two jars), each with its own policy: only one side fires."""
+    from dataclasses import replace
+
+    from confront.arena.control import ControlConfig
+    from confront.engine.evaluate import evaluate_policy
+
+    fires, holds = _q_policy(4), replace(_q_policy(4), control=ControlConfig(fire=False))
+    for ours, theirs in ((fires, holds), (holds, fires)):
+        res, ratio = evaluate_policy(ours, scenario, "td", rounds=2, seed=1, opponent_policy=theirs)
+        mine = next(r for r in res.contestants if r.name.startswith(("confront.PolicyBot 1.0", "confrontteams.Ours")))
+        other = next(r for r in res.contestants if r is not mine)
+        assert ratio == pytest.approx(mine.total / (mine.total + other.total))
+        assert (mine.bullet_dmg > 0, other.bullet_dmg > 0) == (ours.control.fire, theirs.control.fire)
+    with pytest.raises(ValueError, match="export mode"):
+        evaluate_policy(fires, scenario, "td", mode="bridge", opponent_policy=holds)
 
 
 def _trained_like(kind: str):

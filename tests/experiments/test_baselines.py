@@ -160,6 +160,35 @@ def test_sb3_policy_state_round_trip() -> None:
         b.load_state_dict({})
 
 
+@sb3_only
+def test_sb3_export_decides_as_sb3s_deterministic_predict() -> None:
+    """The exported MLP (the actor's layers with their tanh, then the action net) takes SB3's deterministic
+    action on observations of real battles."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.logger import Logger
+
+    from confront.arena.observe import ObservationConfig
+    from confront.experiments.baselines import SB3Policy, SharedTeamVecEnv, sb3_activation, sb3_exported_policy
+
+    env = SharedTeamVecEnv(SHORT, B, seed=4, opponents="SpinBot")
+    model = PPO("MlpPolicy", env, n_steps=16, batch_size=32, n_epochs=2, seed=3, device="cpu")
+    model.set_logger(Logger(folder=None, output_formats=[]))
+    model.learn(total_timesteps=16 * env.num_envs)  # one update: the weights leave their initialisation
+    policy = SB3Policy(model, 4)
+    exported = sb3_exported_policy(policy.state_dict(), sb3_activation(model), ObservationConfig(), 10)
+    assert exported.kind == "mlp" and exported.hidden_activation == "tanh" and len(exported.weights) == 3
+    rng = np.random.default_rng(0)
+    obs = [env.reset()]
+    for _ in range(40):
+        obs.append(env.step(policy.act(obs[-1], rng))[0])
+    batch = np.concatenate(obs)
+    want = policy.act(batch, rng, explore=False)
+    np.testing.assert_array_equal([int(np.argmax(exported.values_of(0, f))) for f in batch], want)
+    assert len(set(want.tolist())) > 1  # more than one action decided
+    with pytest.raises(ValueError, match="action_net.weight"):
+        sb3_exported_policy({}, "tanh", ObservationConfig(), 10)
+
+
 def test_tiny_end_to_end(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path / "cache"))
     cfg = BaselinesConfig(overrides=("opponent.pretrain_rounds=4", "train.replay=false", "arena.battles=2"),

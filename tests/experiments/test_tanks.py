@@ -2,6 +2,7 @@
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -280,6 +281,84 @@ def test_baseline_cache_is_kept_per_td_team(tmp_path) -> None:
     assert method_shares(RANDOM_METHOD, 0, entries, "/b/td/aaaa", 2, tmp_path)["1v1:SittingDuck"] == 0.123
     assert method_shares(RANDOM_METHOD, 0, entries, "/a/td/bbbb", 2, tmp_path)["1v1:SittingDuck"] == played
     assert json.loads(cache.read_text())["td_team"] == "bbbb"
+
+
+def test_engine_comparison_caches_each_battle_and_plays_the_td_team_as_policybots(tmp_path, monkeypatch) -> None:
+    from confront.engine import evaluate as engine_evaluate
+    from confront.experiments.baselines import RANDOM_METHOD
+    from confront.experiments.episodes import save_model
+    from confront.experiments.tank_compare import engine_method_shares
+    from confront.learning.tabular import TabularQ
+
+    td = tmp_path / "td" / "abcd"
+    save_model(td, TabularQ(), {})
+    played = []
+
+    def battle(policy, scenario, opponents, rounds=100, seed=0, opponent_policy=None):  # noqa: ANN001, ANN202
+        played.append({"policy": policy, "entry": f"{scenario}:{opponents}", "rounds": rounds, "seed": seed,
+                       "theirs": opponent_policy})
+        return None, 0.25 + 0.01 * len(played)
+
+    monkeypatch.setattr(engine_evaluate, "evaluate_policy", battle)
+    entries, work = ["1v1:SpinBot", "4v4:td"], tmp_path / "work"
+    got = engine_method_shares(RANDOM_METHOD, 0, entries, str(td), 3, work)
+    assert got == {"1v1:SpinBot": 0.26, "4v4:td": 0.27}
+    spin, team = played
+    assert (spin["entry"], spin["rounds"], spin["seed"], spin["theirs"]) == ("1v1:SpinBot", 3, 1, None)
+    ours = spin["policy"]  # random moves: zero move values, random ties, the baselines' T = 10
+    assert ours.kind == "qtable" and not ours.q.any() and ours.ties == "random" and ours.step_turns == 10
+    theirs = team["theirs"]  # the TD team: its table, greedy with random ties, at the baselines' step length
+    assert theirs.kind == "qtable" and theirs.ties == "random" and theirs.step_turns == 10
+    np.testing.assert_array_equal(theirs.q, TabularQ().state_dict()["q"])
+    assert engine_method_shares(RANDOM_METHOD, 0, entries, "/elsewhere/td/abcd", 3, work) == got  # cached
+    assert len(played) == 2
+    cache = work / "engine" / "Random_moves-seed-0.json"
+    kept = json.loads(cache.read_text())
+    assert kept["td_team"] == "abcd" and kept["engine_seed"] == 1 and kept["rounds"] == 3
+    del kept["shares"]["4v4:td"]  # a comparison stopped after its first battle plays only the missing one
+    cache.write_text(json.dumps(kept))
+    assert engine_method_shares(RANDOM_METHOD, 0, entries, str(td), 3, work)["4v4:td"] == 0.28
+    assert [b["entry"] for b in played] == ["1v1:SpinBot", "4v4:td", "4v4:td"]
+    engine_method_shares(RANDOM_METHOD, 0, entries, str(td), 4, work)  # other rounds: every battle again
+    assert len(played) == 5
+
+
+def test_engine_comparison_pairs_each_seed_with_the_reports_engine_mean(tmp_path, monkeypatch) -> None:
+    from confront.experiments import episodes
+    from confront.experiments import tank_compare as tc
+
+    entries = ["1v1:SittingDuck", "1v1:dodge", "4v4:td"]
+    ours = {e: [[0.5 + 0.1 * k, 0.6 + 0.1 * k, 0.7 + 0.1 * k] for k in range(5)] for e in entries}
+    ours["1v1:SittingDuck"] = [[1.0] * 3] * 5
+    rep = {"runs": [f"seed{k}" for k in range(5)], "engine_runs": [f"seed{k}" for k in range(5)], "rounds": 100,
+           "engine_seeds": 3, "play": "sampled", "rows": [{"entry": e, "engine_runs": ours[e]} for e in entries]}
+    (tmp_path / "results.json").write_text(json.dumps(rep))
+    calls = []
+
+    def shares(method, seed, entries, td_model, rounds, work, engine_seed):  # noqa: ANN001, ANN202
+        calls.append((method, seed, td_model, rounds, engine_seed))
+        return {"1v1:SittingDuck": 1.0, "4v4:td": 0.5 + 0.1 * seed}  # 0.1 below PPO tanks' mean at every seed
+
+    monkeypatch.setattr(tc, "engine_method_shares", shares)
+    monkeypatch.setattr(episodes, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
+    res = tc.compare_engine(tmp_path / "results.json", tmp_path / "out", 7, tmp_path / "work")
+    assert res["seeds"] == [0, 1, 2, 3, 4] and res["entries"] == ["1v1:SittingDuck", "4v4:td"]
+    assert calls[:3] == [(m, 0, "/c/td/t0", 7, 1) for m in tc.METHODS] and len(calls) == 15
+    assert res["shares"][tc.OURS]["4v4:td"] == pytest.approx([0.6 + 0.1 * k for k in range(5)])
+    for m in tc.METHODS:
+        assert res["tests"][m]["4v4:td"]["diff"] == pytest.approx(0.1)
+        assert res["tests"][m]["4v4:td"]["p"] == pytest.approx(1 / 32, abs=0.01)
+        assert res["tests"][m]["1v1:SittingDuck"]["diff"] == 0.0 and res["tests"][m]["1v1:SittingDuck"]["p"] == 1
+    assert json.loads((tmp_path / "out" / "compare-engine.json").read_text())["engine"] == {
+        "engine_seed": 1, "ours_rounds": 100, "ours_battles": 3, "ours_play": "sampled"}
+    md = (tmp_path / "out" / "compare-engine.md").read_text()
+    assert "the mean of 3 battles x 100 rounds (engine seeds 1-3)" in md
+    assert "1 battle x 7 rounds (engine seed 1)" in md
+    assert "| 4v4:td | 0.800 | 0.700 | 0.700 | 0.700 |" in md and "DMNN (FLM) on 1 of 2 entries" in md
+    assert not (tmp_path / "out" / "compare.md").exists()
+    assert tc.run_seed("seed3") == 3 and tc.run_seed("runs/tanks-seed-12") == 12
+    with pytest.raises(ValueError, match="training seed"):
+        tc.run_seed("shipped")
 
 
 def test_report_curves_come_from_the_first_run_with_round_metrics(tmp_path, capsys) -> None:

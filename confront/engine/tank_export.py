@@ -313,7 +313,8 @@ def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Seq
         spec = single_star(scenario_battle(scenario, TANK_ROBOT, opponents, rounds=rounds), "confront.PolicyBot*")
         res = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms), extra_robots=robots,
                          install=install).results
-    ours = next(r for r in res.contestants if r.name.startswith(("confront.", "confrontteams.Ours")))
+    # by name: in 1v1 against an exported PolicyBot both robots' names start with "confront."
+    ours = next(r for r in res.contestants if r.name.startswith((TANK_ROBOT.split()[0], "confrontteams.Ours")))
     return res, res.score_ratio(ours.name)
 
 

@@ -541,6 +541,27 @@ def test_tankbot_against_a_paper_move_team_in_the_engine(install) -> None:
 
 
 @pytest.mark.engine
+def test_tankbot_share_is_its_own_against_a_policybot_1v1(install) -> None:
+    """1v1 against an exported PolicyBot both names start with "confront.": the share returned is TankBot's, also
+    when the PolicyBot ranks first (here TankBot holds still and never fires)."""
+    from confront.engine.tank_export import TANK_ROBOT, evaluate_tank_policy
+    from confront.experiments.spec import load_experiment
+    from confront.experiments.tanks import paper_move_robot
+
+    sizes = [SPACE.n_features, 8, 8, sum(SPACE.dims)]
+    b2 = np.zeros(sum(SPACE.dims))
+    b2[np.cumsum((0,) + SPACE.dims[:-1]) + np.array((2, 2, 0, 0, 0))] = 10.0  # no move, no turn, hold fire
+    still = TankPolicy(tuple(np.zeros((o, i)) for i, o in zip(sizes, sizes[1:], strict=False)),
+                       (np.zeros(8), np.zeros(8), b2), SPACE, ControlConfig(), 5)
+    theirs = paper_move_robot(load_experiment("tanks-demo"), "dodge")
+    res, share = evaluate_tank_policy(still, "1v1", "dodge", rounds=1, seed=1, opponent_policy=theirs,
+                                      install=install)
+    ours = next(c for c in res.contestants if c.name.startswith(TANK_ROBOT.split()[0]))
+    assert res.contestants[0].name != ours.name  # the PolicyBot won
+    assert share == res.score_ratio(ours.name) < 0.5
+
+
+@pytest.mark.engine
 def test_second_team_knows_its_mates_like_the_simulator(install, tmp_path) -> None:
     """Robocode 1.9.3.9 lists the mates of a team that is not first in the battle under names they do not have
     (isTeammate fails there); the exported robots also count whoever sent them a message as a mate. A tank team

@@ -14,7 +14,8 @@ if "OMP_WAIT_POLICY" not in _os.environ:
     _os.environ.setdefault("GOMP_SPINCOUNT", "3000")
 # NumPy's OpenBLAS workers likewise busy-wait 2^28 cycles (about 0.1 s) after each product; the self-play
 # opponent's and the paper learners' small products then kept a core spinning beside the simulator's threads:
-# 2^4 cycles instead made PPO training 1.25x faster end to end (docs/learning.md). Set before NumPy loads.
+# 2^4 cycles instead made PPO training on the whole league 1.5x faster (docs/learning.md). Set before NumPy
+# loads.
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
 import gymnasium as _gym  # noqa: E402

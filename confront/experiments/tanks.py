@@ -354,8 +354,8 @@ class TankTrainer:
             self.obs = st.obs
             crit = self._critic(self.obs)
         # the values of the whole rollout in one product (the weights acted with; cheaper than one per step)
-        values = self.ppo.values(np.concatenate([buf.critic.reshape(s * n, -1), crit]), threads=c.threads)
-        buf.value[...], buf.last_value = values[:s * n].reshape(s, n), values[s * n:]
+        buf.value[...] = self.ppo.values(buf.critic.reshape(s * n, -1), threads=c.threads).reshape(s, n)
+        buf.last_value = self.ppo.values(crit)
         return buf, t_env
 
     def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:

@@ -342,7 +342,7 @@ class TankTrainer:
                       active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
         t_env = 0.0
         for k in range(s):
-            joint, heads, logp, _ = self.ppo.act(self.obs)
+            joint, heads, logp = self.ppo.act(self.obs)
             te = time.perf_counter()
             st: PoolStep = pool.step(joint)
             t_env += time.perf_counter() - te

@@ -299,11 +299,10 @@ class PPO:
         return np.concatenate([obs, team_mean(obs, group, n_groups, alive)], axis=1)
 
     @torch.no_grad()
-    def act(self, obs: np.ndarray, critic_in: np.ndarray | None = None, explore: bool = True
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(joint actions (N,), heads (N, H), log-probabilities (N,), values (N,)) for (N, F) observations;
-        sampled per head (Gumbel-max over the ``act_gen`` stream), or greedy (per-head argmax, ties to the lower
-        index) without ``explore``; values are 0 without ``critic_in``."""
+    def act(self, obs: np.ndarray, explore: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(joint actions (N,), heads (N, H), log-probabilities (N,)) for (N, F) observations; sampled per head
+        (Gumbel-max over the ``act_gen`` stream), or greedy (per-head argmax, ties to the lower index) without
+        ``explore``. The values of a rollout come apart, from :meth:`values` on its critic inputs."""
         lp = self.acting.log_probs(torch.from_numpy(np.ascontiguousarray(obs, dtype=np.float32)))
         if explore:
             u = torch.rand(lp.shape, generator=self.act_gen).clamp_(min=1e-20)
@@ -311,10 +310,8 @@ class PPO:
         else:
             h = lp.argmax(dim=2)
         logp = lp.gather(2, h[:, :, None]).sum(dim=(1, 2))
-        value = (self.acting.value(torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))).numpy()
-                 if critic_in is not None else np.zeros(len(obs), np.float32))
         hn = h.numpy()
-        return np.ravel_multi_index(tuple(hn.T), self.dims), hn, logp.numpy(), value
+        return np.ravel_multi_index(tuple(hn.T), self.dims), hn, logp.numpy()
 
     @torch.no_grad()
     def values(self, critic_in: np.ndarray, threads: int | None = None) -> np.ndarray:

@@ -54,8 +54,8 @@ def _bandit_rollout(ppo: PPO, rng: np.random.Generator, s: int = 8, n: int = 64)
     heads, logp, value = np.zeros((s, n, 2), np.int64), np.zeros((s, n), np.float32), np.zeros((s, n), np.float32)
     reward = np.zeros((s, n))
     for t in range(s):
-        _, h, lp, v = ppo.act(obs[t], obs[t])
-        heads[t], logp[t], value[t] = h, lp, v
+        _, h, lp = ppo.act(obs[t])
+        heads[t], logp[t], value[t] = h, lp, ppo.values(obs[t])
         reward[t] = (h[:, 0] == (obs[t, :, 0] > 0)).astype(float)
     return Rollout(obs, obs.copy(), heads, logp, value, reward, np.ones((s, n), bool), np.ones((s, n), bool),
                    np.zeros(n, np.float32))
@@ -68,7 +68,7 @@ def test_learns_a_contextual_bandit() -> None:
     for _ in range(40):
         ppo.update(_bandit_rollout(ppo, rng))
     obs = np.array([[1.0, 1.0], [-1.0, 1.0]], np.float32)
-    joint, heads, _, _ = ppo.act(obs, explore=False)
+    joint, heads, _ = ppo.act(obs, explore=False)
     assert first < 0.7
     assert heads[:, 0].tolist() == [1, 0]  # head 0 follows the sign of feature 0
     assert _bandit_rollout(ppo, rng).reward.mean() > 0.95

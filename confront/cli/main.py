@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -96,16 +97,19 @@ def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, co
 @click.option("--seed", type=SEED, default=None)
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True,
               help="Train in the simulator or live in the real Robocode engine (checkpointed per battle).")
+@click.option("--init", "init", type=click.Path(path_type=Path, exists=True, file_okay=False), default=None,
+              help="PPO: start from this run's model (model/ppo.npz), e.g. fine-tune a simulator run with "
+                   "--engine robocode (train.init).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @set_option
-def train(config: str, out: Path | None, resume: Path | None, seed: int | None, engine: str, quiet: bool,
-          overrides: tuple[str, ...]) -> None:
+def train(config: str, out: Path | None, resume: Path | None, seed: int | None, engine: str, init: Path | None,
+          quiet: bool, overrides: tuple[str, ...]) -> None:
     """Train one arm of an experiment; --resume RUN continues a killed run from its latest checkpoint."""
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import print_summary, train_run
 
     if resume is not None:  # a resumed run continues with its own config.toml and folder
-        given = [name for name, value in (("--set", overrides), ("--out", out), ("--seed", seed))
+        given = [name for name, value in (("--set", overrides), ("--out", out), ("--seed", seed), ("--init", init))
                  if value not in (None, ())]
         if click.get_current_context().get_parameter_source("config") is click.core.ParameterSource.COMMANDLINE:
             given.insert(0, "-c")
@@ -116,6 +120,8 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
         summary = train_run(None, resume, resume=True, progress=not quiet, engine=engine)
     else:
         extra = (f"train.seed={seed}",) if seed is not None else ()
+        if init is not None:  # absolute: the run's config.toml must find it from anywhere
+            extra += (f"train.init={json.dumps(str(init.resolve()))}",)
         cfg = load_experiment(config, overrides + extra)
         summary = train_run(cfg, out, progress=not quiet, engine=engine)
     print_summary(summary)

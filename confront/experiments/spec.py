@@ -230,6 +230,8 @@ class TrainSection:
     session_rounds: int = field(10, ge=1, doc="rounds per session (paper: 10)")
     seed: int = field(0, ge=0, le=2**32 - 1)
     checkpoint_every: int = field(50, ge=1, doc="rounds between checkpoints")
+    init: str = field("", doc="PPO: a run folder whose model (model/ppo.npz) the learner starts from (e.g. a "
+                      "simulator run fine-tuned in the engine); empty = from scratch")
     replay: bool = field(True, doc="record the last round of battle 0 as a replay")
 
 

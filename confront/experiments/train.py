@@ -2,12 +2,13 @@
 
     config -> Trainer (learner x backend) -> advance() until train.rounds -> rows -> sessions, model, plots
 
-A :class:`Trainer` plays and learns in steps and holds all it changes as data. Three implement it:
+A :class:`Trainer` plays and learns in steps and holds all it changes as data. Four implement it:
 :class:`~confront.experiments.episodes.SMDPTrainer` (the paper's learners in the simulator),
-:class:`~confront.experiments.tanks.TankTrainer` (PPO tanks in the simulator's league) and
+:class:`~confront.experiments.tanks.TankTrainer` (PPO tanks in the simulator's league),
 :class:`~confront.experiments.train_engine.EngineTrainer` (the paper's learners live in Robocode, one battle
-per step). One loop advances them all, :func:`~confront.experiments.episodes.run_rounds` (also the TD team's
-pre-training); :func:`train_run` wraps it in a run folder, the same for all three: resume, progress bar,
+per step) and :class:`~confront.experiments.tanks_engine.EngineTankTrainer` (PPO tanks in Robocode, one battle
+and one update per step). One loop advances them all, :func:`~confront.experiments.episodes.run_rounds` (also
+the TD team's pre-training); :func:`train_run` wraps it in a run folder, the same for all four: resume, progress bar,
 TensorBoard scalars (``tb/``), checkpoints every ``train.checkpoint_every`` rounds, then the run's tables,
 summary and figures.
 
@@ -89,10 +90,16 @@ def make_trainer(cfg: ExperimentConfig, run: Run, engine: str = "sim", progress:
     """The trainer of ``cfg``'s learner on ``engine`` (imports the backend it needs only)."""
     if engine not in ENGINES:
         raise ConfigError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if cfg.train.init and cfg.learner.kind != "ppo":
+        raise ConfigError("train.init starts a PPO learner from a run's model; for the paper's learners use "
+                          "transfer.source")
     if cfg.learner.kind == "ppo":
-        if engine != "sim":
-            raise ConfigError("PPO tanks train in the simulator (all league battles in one call); "
-                              "`confront export RUN` makes the trained policy a Robocode robot")
+        if engine == "robocode":
+            from confront.experiments.tanks_engine import EngineTankTrainer
+
+            return EngineTankTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
+        if cfg.train.init:
+            raise ConfigError("train.init (a PPO run to start from) is used in the engine only (--engine robocode)")
         from confront.experiments.tanks import TankTrainer
 
         return TankTrainer(cfg, progress=progress)

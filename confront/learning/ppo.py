@@ -314,6 +314,14 @@ class PPO:
         return np.ravel_multi_index(tuple(hn.T), self.dims), hn, logp.numpy()
 
     @torch.no_grad()
+    def log_prob(self, obs: np.ndarray, heads: np.ndarray) -> np.ndarray:
+        """Log-probabilities (N,) of the actions with heads (N, H) at (N, F) observations under the acting
+        policy (what :meth:`act` returns for its own draws; for actions sampled elsewhere, e.g. by TankBot)."""
+        lp = self.acting.log_probs(torch.from_numpy(np.ascontiguousarray(obs, dtype=np.float32)))
+        h = torch.from_numpy(np.ascontiguousarray(heads, dtype=np.int64))
+        return lp.gather(2, h[:, :, None]).sum(dim=(1, 2)).numpy()
+
+    @torch.no_grad()
     def values(self, critic_in: np.ndarray, threads: int | None = None) -> np.ndarray:
         """V of (N, C) critic inputs (on ``threads`` torch threads for this call, e.g. a whole rollout's)."""
         x = torch.from_numpy(np.ascontiguousarray(critic_in, dtype=np.float32))

@@ -39,6 +39,11 @@ import robocode.control.snapshot.ITurnSnapshot;
  * Writes the engine's own results table (same writer as the command line's -results), a JSON summary
  * (turn counts, skipped turns, exact score parts per robot and per contestant, timings) and, when asked,
  * a JSONL trace of every turn. Arguments: WORKDIR BATTLE_FILE RESULTS_FILE SUMMARY_FILE [TRACE_FILE].
+ *
+ * <p>With the JVM property confront.scores=PATH it also writes each robot's current-round score per turn
+ * (PPO training in the engine, confront.experiments.tanks_engine): a line "round turn alive s_0 ... s_n-1"
+ * (robots in snapshot order, alive a string of 0/1, scores by Double.toString) at each round's first turn and
+ * whenever a score or a robot's life changed since the line before.
  */
 public final class ConfrontRunner extends BattleAdaptor {
     private final Writer trace;
@@ -59,6 +64,10 @@ public final class ConfrontRunner extends BattleAdaptor {
     private RobocodeEngine engine;
     private int maxTurns;
     private int abortedAt = -1;
+    private Writer scores;  // confront.scores: per-turn current scores, written on change
+    private double[] lastScores = new double[0];
+    private String lastAlive = "";
+    private int scoresRound = -1;
 
     private ConfrontRunner(Writer trace) {
         this.trace = trace;
@@ -82,6 +91,11 @@ public final class ConfrontRunner extends BattleAdaptor {
         ConfrontRunner runner = new ConfrontRunner(trace);
         runner.engine = engine;
         runner.maxTurns = Integer.parseInt(battle.getProperty("confront.maxTurns", "0"));
+        String scorePath = System.getProperty("confront.scores");
+        if (scorePath != null && !scorePath.isEmpty()) {
+            runner.scores = new BufferedWriter(new OutputStreamWriter(new FileOutputStream(scorePath),
+                    StandardCharsets.UTF_8));
+        }
         engine.addBattleListener(runner);
         int exit = 0;
         try {
@@ -116,6 +130,9 @@ public final class ConfrontRunner extends BattleAdaptor {
         } finally {
             if (trace != null) {
                 trace.close();
+            }
+            if (runner.scores != null) {
+                runner.scores.close();
             }
             engine.close();
         }
@@ -193,6 +210,9 @@ public final class ConfrontRunner extends BattleAdaptor {
         if (abortedAt >= 0) {
             return;
         }
+        if (scores != null) {
+            writeCurrentScores(snap);
+        }
         if (trace != null) {
             writeTurn(snap, "turn");
         }
@@ -205,6 +225,40 @@ public final class ConfrontRunner extends BattleAdaptor {
             Thread stopper = new Thread(engine::abortCurrentBattle, "confront-stop");
             stopper.setDaemon(true);
             stopper.start();
+        }
+    }
+
+    /** The confront.scores line of this turn, when a score or a robot's life changed (or a round began). */
+    private void writeCurrentScores(ITurnSnapshot snap) {
+        IRobotSnapshot[] rs = snap.getRobots();
+        StringBuilder alive = new StringBuilder(rs.length);
+        boolean changed = snap.getRound() != scoresRound || lastScores.length != rs.length;
+        if (changed) {
+            lastScores = new double[rs.length];
+        }
+        for (int i = 0; i < rs.length; i++) {
+            alive.append(rs[i].getState() == robocode.control.snapshot.RobotState.DEAD ? '0' : '1');
+            double s = rs[i].getScoreSnapshot().getCurrentScore();
+            if (s != lastScores[i]) {
+                changed = true;
+                lastScores[i] = s;
+            }
+        }
+        if (!changed && alive.toString().equals(lastAlive)) {
+            return;
+        }
+        scoresRound = snap.getRound();
+        lastAlive = alive.toString();
+        StringBuilder b = new StringBuilder(32 + 24 * rs.length);
+        b.append(snap.getRound()).append(' ').append(snap.getTurn()).append(' ').append(lastAlive);
+        for (double s : lastScores) {
+            b.append(' ').append(Double.toString(s));
+        }
+        b.append('\n');
+        try {
+            scores.write(b.toString());
+        } catch (IOException e) {
+            errors.add("score log write failed: " + e.getMessage());
         }
     }
 

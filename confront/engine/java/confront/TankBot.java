@@ -1,7 +1,11 @@
 package confront;
 
+import java.io.File;
+import java.io.FileInputStream;
+import java.io.FileOutputStream;
 import java.io.IOException;
 import java.io.InputStream;
+import java.io.OutputStream;
 import java.io.InputStreamReader;
 import java.io.Reader;
 import java.io.StringReader;
@@ -11,6 +15,7 @@ import java.util.LinkedHashMap;
 import java.util.Map;
 import java.util.Set;
 
+import robocode.DeathEvent;
 import robocode.MessageEvent;
 import robocode.RobotDeathEvent;
 import robocode.RoundEndedEvent;
@@ -31,8 +36,18 @@ import robocode.util.Utils;
  *
  * <p>Robocode makes a new robot object each round, so the memory starts empty every round. A team-mate's
  * broadcast arrives one turn later, so mates are seen as they were a turn ago (and not at all at turn 0).
+ *
+ * <p>Training in the engine (confront.experiments.tanks_engine; needs -DNOSECURITY=true): the JVM property
+ * confront.tank.model names a policy file read instead of TankData, and confront.tank.log a folder where each
+ * robot appends one line per decision to its own file (LOG_SUFFIX): name, round, turn, joint action, the view
+ * (Double.toString, exact), the uniform draws, and with confront.tank.log.detail=true what the view was made
+ * from (TankCheck's "V" request: own values, enemy rows, mate rows), tab-separated.
  */
 public class TankBot extends TeamRobot {
+    static final String MODEL_PROPERTY = "confront.tank.model";
+    static final String LOG_PROPERTY = "confront.tank.log";
+    static final String DETAIL_PROPERTY = "confront.tank.log.detail";
+    static final String LOG_SUFFIX = ".decisions";
     /** name: {x, y, energy, heading, velocity, energy drop, scan time, turn rate} of the last scan this round. */
     private final Map<String, double[]> enemies = new LinkedHashMap<>();
     /** name: {x, y, energy} of the latest message this round. */
@@ -41,6 +56,8 @@ public class TankBot extends TeamRobot {
     private final Set<String> heard = new HashSet<>();  // names that sent us a message: team-mates
     private int decisions;
     private int shots;
+    private OutputStream log;  // the decision log of this round (confront.tank.log), opened at the first decision
+    private boolean detail;
 
     @Override
     public void run() {
@@ -58,6 +75,8 @@ public class TankBot extends TeamRobot {
                 execute();
             }
         }
+        String logDir = property(LOG_PROPERTY);
+        detail = "true".equals(property(DETAIL_PROPERTY));
         String[] team = getTeammates();
         int matesStart = team == null ? 0 : team.length;
         int enemiesStart = Math.max(getOthers() - matesStart, 0);
@@ -82,7 +101,12 @@ public class TankBot extends TeamRobot {
                             getGunHeat(), Math.max(getOthers() - matesAlive, 0), enemiesStart, matesAlive,
                             matesStart, known, mates.values().toArray(new double[0][]), time,
                             getBattleFieldWidth(), getBattleFieldHeight(), slots);
-                    a = model.decode(model.sampled() ? model.sample(v, draws(model.dims().length)) : model.act(v));
+                    double[] u = model.sampled() ? draws(model.dims().length) : new double[0];
+                    int joint = model.sampled() ? model.sample(v, u) : model.act(v);
+                    if (logDir != null) {
+                        logDecision(logDir, time, joint, v, u, enemiesStart, matesAlive, matesStart, known);
+                    }
+                    a = model.decode(joint);
                     power = a[2];
                     lead = (int) a[4];
                     int k = (int) a[3];
@@ -129,8 +153,86 @@ public class TankBot extends TeamRobot {
         return u;
     }
 
-    /** The policy compiled into confront.TankData (written at export), else tank_policy.txt beside the class. */
+    /** A JVM property, or null (also when the sandbox refuses to tell). */
+    private static String property(String name) {
+        try {
+            String v = System.getProperty(name);
+            return v == null || v.isEmpty() ? null : v;
+        } catch (SecurityException e) {
+            return null;
+        }
+    }
+
+    /** One line of the decision log (see the class comment); written at once, unbuffered (a robot's thread may
+     *  be stopped at any time). */
+    private void logDecision(String dir, double time, int joint, double[] v, double[] u, int enemiesStart,
+                             int matesAlive, int matesStart, double[][] known) {
+        StringBuilder b = new StringBuilder(2048);
+        b.append(getName()).append('\t').append(getRoundNum()).append('\t').append((long) time).append('\t')
+                .append(joint).append('\t');
+        join(b, v);
+        b.append('\t');
+        join(b, u);
+        if (detail) {
+            b.append('\t');
+            join(b, new double[] {getX(), getY(), getHeadingRadians(), getVelocity(), getEnergy(), getGunHeat(),
+                    Math.max(getOthers() - matesAlive, 0), enemiesStart, matesAlive, matesStart, time,
+                    getBattleFieldWidth(), getBattleFieldHeight()});
+            b.append('\t');
+            rows(b, known);
+            b.append('\t');
+            rows(b, mates.values().toArray(new double[0][]));
+        }
+        b.append('\n');
+        try {
+            if (log == null) {
+                String safe = getName().replaceAll("[^A-Za-z0-9._-]", "_");
+                log = new FileOutputStream(new File(dir, safe + LOG_SUFFIX), true);
+            }
+            log.write(b.toString().getBytes(StandardCharsets.UTF_8));
+        } catch (IOException e) {
+            out.println("CONFRONT tank-error log " + e);
+        }
+    }
+
+    private static void join(StringBuilder b, double[] v) {
+        for (int i = 0; i < v.length; i++) {
+            if (i > 0) {
+                b.append(' ');
+            }
+            b.append(Double.toString(v[i]));
+        }
+    }
+
+    private static void rows(StringBuilder b, double[][] rows) {
+        for (int i = 0; i < rows.length; i++) {
+            if (i > 0) {
+                b.append('|');
+            }
+            join(b, rows[i]);
+        }
+    }
+
+    private void closeLog() {
+        if (log != null) {
+            try {
+                log.close();
+            } catch (IOException e) {
+                out.println("CONFRONT tank-error log " + e);
+            }
+            log = null;
+        }
+    }
+
+    /** The policy file named by confront.tank.model, else the one compiled into confront.TankData (written at
+     *  export), else tank_policy.txt beside the class. */
     private TankModel load() throws IOException {
+        String path = property(MODEL_PROPERTY);
+        if (path != null) {
+            try (Reader r = new InputStreamReader(new FileInputStream(path), StandardCharsets.UTF_8)) {
+                return TankModel.read(r);
+            }
+        }
         try {
             String[] chunks = (String[]) Class.forName("confront.TankData").getField("CHUNKS").get(null);
             return TankModel.read(new StringReader(String.join("", chunks)));
@@ -211,7 +313,13 @@ public class TankBot extends TeamRobot {
     }
 
     @Override
+    public void onDeath(DeathEvent e) {
+        closeLog();
+    }
+
+    @Override
     public void onRoundEnded(RoundEndedEvent e) {
+        closeLog();
         out.println("CONFRONT tank-round decisions=" + decisions + " shots=" + shots);
     }
 }

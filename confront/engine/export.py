@@ -287,11 +287,12 @@ def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall
                        "A policy trained with confront (fuzzy RL), exported with its own inference", install, version)
 
 
-def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str, policy_file: str, text: str,
+def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str | None, policy_file: str, text: str,
                 description: str, install: EngineInstall | None = None, version: str = "1.0") -> Path:
     """A robot ``confront.<bot>`` as a robots folder or a ``.jar``: the project's compiled ``classes`` and their
     sources, ``<bot>.properties``, the policy ``text`` as ``policy_file`` and compiled into the class ``data``
-    (string constants: the robot reads no file, in the engine's sandbox or from a jar)."""
+    (string constants: the robot reads no file, in the engine's sandbox or from a jar; ``None``: no such class,
+    no javac run)."""
     install = install or find_engine()
     compiled = compile_java(install)
     out = Path(out)
@@ -308,11 +309,12 @@ def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str, 
             f"robot.description={description}\nrobot.java.source.included=true\nrobocode.version=1.9.3.9\n"
         )
         (pkg / policy_file).write_text(text)
-        (pkg / f"{data}.java").write_text(policy_data_source(text, name=data))
-        proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),
-                               str(pkg / f"{data}.java")], capture_output=True, text=True, check=False)
-        if proc.returncode != 0:
-            raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
+        if data is not None:
+            (pkg / f"{data}.java").write_text(policy_data_source(text, name=data))
+            proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),
+                                   str(pkg / f"{data}.java")], capture_output=True, text=True, check=False)
+            if proc.returncode != 0:
+                raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
         if out.suffix == ".jar":
             jar = shutil.which("jar") or str(Path(install.javac).with_name("jar"))
             out.parent.mkdir(parents=True, exist_ok=True)

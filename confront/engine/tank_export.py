@@ -285,14 +285,18 @@ class TankPolicy:
         return "\n".join(lines) + "\n"
 
 
-def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstall | None = None) -> Path:
+def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstall | None = None,
+                      embed: bool = True) -> Path:
     """Write the standalone robot ``confront.TankBot`` with ``policy``: a robots folder or a ``.jar``.
 
     It holds ``confront/TankBot.class``, ``TankModel.class``, ``RoundStart.class``, ``TankData.class`` (the
     policy as string constants, so the robot reads no file), ``TankBot.properties``, ``tank_policy.txt``
-    and the Java sources."""
-    return write_robot(out, "TankBot", TANK_CLASSES, "TankData", "tank_policy.txt", policy.to_text(),
-                       "A tank policy trained with confront (PPO), exported with its own inference", install)
+    and the Java sources. ``embed=False`` leaves out TankData (no javac run: engine training): the robot then
+    reads the file the JVM property ``confront.tank.model`` names, else its ``tank_policy.txt``; both need the
+    engine run with ``-DNOSECURITY=true`` (the sandbox refuses robots reading files, their own jar included)."""
+    return write_robot(out, "TankBot", TANK_CLASSES, "TankData" if embed else None, "tank_policy.txt",
+                       policy.to_text(), "A tank policy trained with confront (PPO), exported with its own inference",
+                       install)
 
 
 def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,

@@ -242,8 +242,8 @@ class EngineTankTrainer:
         self._tmp = tempfile.TemporaryDirectory(prefix="confront-tanks-engine-")
         try:
             tmp = Path(self._tmp.name)
-            # the robot once (TankData: the initial policy); each battle's policy comes from confront.tank.model
-            self.jar = export_tank_robot(self.policy(), tmp / "tankbot.jar", install)
+            # the robot once, without TankData (no javac): each battle's policy comes from confront.tank.model
+            self.jar = export_tank_robot(self.policy(), tmp / "tankbot.jar", install, embed=False)
             self.opponents: dict[str, Path] = {}
             for opp in sorted({e.partition(":")[2] for e in self.entries} & set(PAPER_MOVE_OPPONENTS)):
                 self.opponents[opp] = export_robot(paper_move_robot(cfg, opp), tmp / f"opponent-{opp}", install)

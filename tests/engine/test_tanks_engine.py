@@ -214,3 +214,16 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
                 np.testing.assert_array_equal(trainer.ppo.state_dict()[k], a)
     finally:
         trainer.close()
+
+
+@pytest.mark.engine
+def test_robot_without_embedded_policy_reads_its_policy_file(install, tmp_path: Path) -> None:
+    """``export_tank_robot(embed=False)`` (what engine training plays): no TankData, no property: the jar's own
+    tank_policy.txt (readable without the sandbox only, as training runs it)."""
+    policy = replace(_policy(7, TankSpace()), play="greedy")
+    jar = export_tank_robot(policy, tmp_path / "tankbot.jar", install, embed=False)
+    run = run_battle(scenario_battle("1v1", TANK_ROBOT, "SittingDuck", rounds=1),
+                     EngineOptions(seed=1, nosecurity=True), extra_robots=[jar], install=install)
+    assert not any("tank-load-failed" in r for r in run.summary["robot_reports"])
+    ours = next(c for c in run.results.contestants if c.name.startswith("confront.TankBot"))
+    assert ours.total > 0

@@ -143,13 +143,13 @@ def test_one_loop_logs_every_learner_to_tensorboard(reference: tuple[Path, Path]
     assert summary["engine"] == "sim" and summary["setup_s"] >= 0
 
 
-def test_ppo_in_the_engine_is_refused_before_a_run_folder_is_left(tmp_path: Path) -> None:
+def test_ppo_league_the_engine_cannot_play_is_refused_before_a_run_folder_is_left(tmp_path: Path) -> None:
     from confront.config import ConfigError
     from confront.experiments.spec import load_experiment
     from confront.experiments.train import train_run
 
-    with pytest.raises(ConfigError, match="PPO tanks train in the simulator"):
-        train_run(load_experiment("tanks-demo"), tmp_path / "run", progress=False, engine="robocode")
+    with pytest.raises(ConfigError, match="'1v1:strafe' cannot be played in the engine"):  # the first of tanks.toml's
+        train_run(load_experiment("tanks"), tmp_path / "run", progress=False, engine="robocode")
     assert not (tmp_path / "run").exists()
     with pytest.raises(ConfigError, match="engine must be one of"):
         train_run(load_experiment("demo"), tmp_path / "run", progress=False, engine="gazebo")

@@ -12,9 +12,10 @@ Two runs, alternated over ``--repeats`` (the order flips each repetition):
   export is timed apart (``export_s``) and ``battles_s`` is the wall time less one export per battle.
 
 Per run: wall s (the whole ``train_run`` call / the evaluations), the training's time in its battles (writing the
-policy, the engine process, reading the logs and building the rollout: ``engine_s`` of metrics/updates.csv) and in
-its updates (``update_s``), the rest (set-up: the jar's export, torch; checkpoints, tables, model, plots), turns,
-decisions and x exported = train wall / exported wall (and / exported battles without the per-call exports).
+policy file and the engine process: ``engine_s`` of metrics/updates.csv), in reading the logs and building the
+rollout (``rollout_s``) and in its updates (``update_s``), the rest (set-up: the jar's export, torch;
+checkpoints, tables, model, plots), turns, decisions and x exported = train wall / exported wall (and / exported
+battles without the per-call exports).
 Before any timing, one untimed training of ``--warmup-rounds`` rounds and one evaluation warm up what a process
 pays once (imports, the Java build check).
 
@@ -52,9 +53,11 @@ def train_once(cfg: ExperimentConfig, out: Path, rep: int) -> dict[str, Any]:
     with open(out / "metrics" / "rounds.csv") as f:
         turns = sum(int(r["turns"]) for r in csv.DictReader(f))
     engine_s = sum(float(u["engine_s"]) for u in ups)
+    rollout_s = sum(float(u["rollout_s"]) for u in ups)
     update_s = sum(float(u["update_s"]) for u in ups)
-    return {"mode": "train", "repeat": rep, "wall_s": wall, "battles_s": engine_s, "update_s": update_s,
-            "outside_s": wall - engine_s - update_s, "turns": turns, "decisions": summary["decisions"],
+    return {"mode": "train", "repeat": rep, "wall_s": wall, "battles_s": engine_s, "rollout_s": rollout_s,
+            "update_s": update_s, "outside_s": wall - engine_s - rollout_s - update_s, "turns": turns,
+            "decisions": summary["decisions"],
             "skipped_turns": summary["skipped_turns"], "score_ratio": summary["final_score_ratio"],
             "load": os.getloadavg()[0], "run": str(out)}
 
@@ -75,10 +78,12 @@ def exported_once(cfg: ExperimentConfig, run: Path, rep: int, tmp: Path) -> dict
     wall = time.perf_counter() - t0
     return {"mode": "exported", "repeat": rep, "wall_s": wall, "battles_s": wall - n * export_s,
             "export_s": export_s, "update_s": None, "outside_s": None, "turns": None, "decisions": None,
-            "skipped_turns": res.skipped_turns, "score_ratio": statistics.mean(ratios), "load": os.getloadavg()[0]}
+            "skipped_turns": res.skipped_turns, "score_ratio": statistics.mean(ratios), "load": os.getloadavg()[0],
+            "rollout_s": None}
 
 
-COLUMNS = (("wall s", "wall_s", 1), ("in battles s", "battles_s", 1), ("updates s", "update_s", 2),
+COLUMNS = (("wall s", "wall_s", 1), ("in battles s", "battles_s", 1), ("logs to rollout s", "rollout_s", 2),
+           ("updates s", "update_s", 2),
            ("outside s", "outside_s", 1), ("export s", "export_s", 2), ("turns", "turns", 0),
            ("decisions", "decisions", 0), ("skipped", "skipped_turns", 0), ("score ratio", "score_ratio", 3),
            ("load", "load", 1), ("x exported", "ratio", 2), ("x exported battles", "ratio_battles", 2))
@@ -147,6 +152,7 @@ def main() -> None:
               "init": str(args.init) if args.init else None, "repeats": args.repeats,
               "median_ratio": med("train", "ratio"), "median_ratio_battles": med("train", "ratio_battles"),
               "train_wall_s": med("train", "wall_s"), "train_battles_s": med("train", "battles_s"),
+              "train_rollout_s": med("train", "rollout_s"),
               "train_update_s": med("train", "update_s"), "train_outside_s": med("train", "outside_s"),
               "exported_wall_s": med("exported", "wall_s"), "exported_battles_s": med("exported", "battles_s"),
               "export_s": med("exported", "export_s"), "load_average_start": list(load0),

@@ -237,7 +237,7 @@ class EngineTankTrainer:
         self.rows: list[dict[str, Any]] = []
         self.updates: list[dict[str, Any]] = []
         self.battles = self.decisions = self.skipped_turns = 0
-        self.elapsed = self.engine_s = self.update_s = self.engine_setup_s = 0.0
+        self.elapsed = self.engine_s = self.rollout_s = self.update_s = self.engine_setup_s = 0.0
         self.desc = f"{cfg.name} ppo (robocode)"
         self._tmp = tempfile.TemporaryDirectory(prefix="confront-tanks-engine-")
         try:
@@ -279,9 +279,10 @@ class EngineTankTrainer:
             opp = entry.partition(":")[2]
             extra = [self.jar] + ([self.opponents[opp]] if opp in self.opponents else [])
             res = run_battle(_battle(entry, rounds), opts, extra_robots=extra)
-            t1 = time.perf_counter()
+            t_battle = time.perf_counter()
             logged = read_decisions(folder / "log")
             ro, n_dec = self._rollout(res, logged, read_scores(folder / "scores.txt", len(res.summary["robots"])))
+            t1 = time.perf_counter()
         rows = round_rows(res.summary["round_scores"])
         self.decisions += n_dec
         for r in rows:
@@ -297,7 +298,8 @@ class EngineTankTrainer:
         self.battles += 1
         self.skipped_turns += sum(res.skipped_turns.values())
         self.engine_setup_s += res.setup_s
-        self.engine_s += t1 - t0
+        self.engine_s += t_battle - t0
+        self.rollout_s += t1 - t_battle
         self.update_s += t2 - t1
         self.elapsed += t2 - t0
         for r in rows:
@@ -305,7 +307,7 @@ class EngineTankTrainer:
         row = {"update": self.ppo.updates, "battle": self.battles - 1, "opponent": entry, "rounds": self.rounds_done,
                "decisions": self.decisions, "decisions_logged": len(logged),
                "reward_points": float(ro.reward[ro.active].sum()) / self.ppo.config.reward_scale,
-               "wall_s": self.elapsed, "engine_s": t1 - t0, "update_s": t2 - t1,
+               "wall_s": self.elapsed, "engine_s": t_battle - t0, "rollout_s": t1 - t_battle, "update_s": t2 - t1,
                "decisions_per_s": n_dec / max(t2 - t0, 1e-9), "skipped_turns": sum(res.skipped_turns.values()),
                **stats}
         self.updates.append(row)
@@ -376,7 +378,8 @@ class EngineTankTrainer:
         arrays = {f"ppo.{k}": v for k, v in self.ppo.state_dict().items()}
         meta = {"kind": "ppo", "rounds_done": self.rounds_done, "rows": self.rows, "updates": self.updates,
                 "battles": self.battles, "decisions": self.decisions, "skipped_turns": self.skipped_turns,
-                "update_elapsed_s": self.elapsed, "engine_s": self.engine_s, "update_s": self.update_s,
+                "update_elapsed_s": self.elapsed, "engine_s": self.engine_s, "rollout_s": self.rollout_s,
+                "update_s": self.update_s,
                 "setup_s": self.engine_setup_s}
         return arrays, meta
 
@@ -390,6 +393,7 @@ class EngineTankTrainer:
             self.skipped_turns = int(meta["skipped_turns"])
             self.elapsed, self.engine_s = float(meta["update_elapsed_s"]), float(meta["engine_s"])
             self.update_s, self.engine_setup_s = float(meta["update_s"]), float(meta["setup_s"])
+            self.rollout_s = float(meta["rollout_s"])
         except (KeyError, ValueError, TypeError) as exc:
             raise ck.CheckpointError(f"the checkpoint does not fit this run's config: {exc}") from None
 
@@ -407,7 +411,8 @@ class EngineTankTrainer:
                 "share_by_opponent_last": share_by_opponent(rows[-min(self.final_window, len(rows)):]),
                 "decisions_per_s": self.decisions / max(self.elapsed, 1e-9), "figures": [str(f) for f in figs],
                 "battles": self.battles, "cpu_constant_ms": self.cpu_constant_ms,
-                "skipped_turns": self.skipped_turns, "engine_s": self.engine_s, "update_s": self.update_s,
+                "skipped_turns": self.skipped_turns, "engine_s": self.engine_s, "rollout_s": self.rollout_s,
+                "update_s": self.update_s,
                 "engine_setup_s": self.engine_setup_s, **self.info}
 
     def close(self) -> None:

@@ -305,7 +305,7 @@ class EngineTankTrainer:
         for r in rows:
             r["wall_s"] = self.elapsed
         row = {"update": self.ppo.updates, "battle": self.battles - 1, "opponent": entry, "rounds": self.rounds_done,
-               "decisions": self.decisions, "decisions_logged": len(logged),
+               "decisions": self.decisions, "battle_decisions": n_dec, "decisions_logged": len(logged),
                "reward_points": float(ro.reward[ro.active].sum()) / self.ppo.config.reward_scale,
                "wall_s": self.elapsed, "engine_s": t_battle - t0, "rollout_s": t1 - t_battle, "update_s": t2 - t1,
                "decisions_per_s": n_dec / max(t2 - t0, 1e-9), "skipped_turns": sum(res.skipped_turns.values()),

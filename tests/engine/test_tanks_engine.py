@@ -178,7 +178,8 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
     # the decisions kept are those before each round's deciding turn (the round's turns less the engine's 150
     # after it; our tank survives the duck): turns 0, T, 2T, ... < D, so ceil(D / T) per round
     assert not sum(battles[0].skipped_turns.values())
-    assert up["decisions"] == sum(-(-(int(r["turns"]) - 150) // 5) for r in first) < up["decisions_logged"]
+    assert up["decisions"] == up["battle_decisions"] == sum(-(-(int(r["turns"]) - 150) // 5) for r in first)
+    assert up["battle_decisions"] < up["decisions_logged"]  # the robots decide on after the deciding turn
     # 1v1: the rewards of a round add up to its score margin (the runner's round-end totals)
     assert up["reward_points"] == pytest.approx(sum(float(r["score_ours"]) - float(r["score_theirs"])
                                                     for r in first), abs=1e-9)

@@ -225,7 +225,6 @@ class EngineTankTrainer:
     def __init__(self, cfg: ExperimentConfig, run: Run, progress: bool = False,
                  cpu_constant_ms: float | None = None) -> None:
         self.entries = engine_entries(cfg)
-        install = find_engine()  # no engine: a one-line error
         self.cfg, self.run = cfg, run
         self.cpu_constant_ms = TANK_CPU_CONSTANT_MS if cpu_constant_ms is None else cpu_constant_ms
         self.space = tank_space(cfg)
@@ -234,6 +233,7 @@ class EngineTankTrainer:
         if cfg.train.init:
             self.ppo.load_state_dict(load_tank_model(cfg.train.init, cfg).state_dict())
             self.info["init"] = cfg.train.init
+        install = find_engine()  # no engine: a one-line error
         self.rows: list[dict[str, Any]] = []
         self.updates: list[dict[str, Any]] = []
         self.battles = self.decisions = self.skipped_turns = 0

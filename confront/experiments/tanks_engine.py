@@ -21,7 +21,9 @@ Differences to the simulator's reward (``tank.reward = "score"``): a round is cu
 (decisions after it are dropped, the one spanning it ends there), as the simulator ends the round there; the
 engine's 150 turns after the decision are not learned from. A decision turn a robot skipped is made up a turn
 later (the step is a turn longer, the one before it shorter). The team critic's mean view is taken over the
-team-mates that decided in the same turn (the simulator includes dead tanks with weight 1e-6).
+team-mates that decided in the same turn (the simulator includes dead tanks with weight 1e-6). The rewards follow
+the robots' current-round scores (as the simulator's), which in team battles grow after a robot's death by its
+bullets in flight; the rows (``round_rows``: the engine's totals, closed at each robot's death) do not count them.
 
 Run folder: the simulator's (config.toml, metrics/rounds.csv with EngineTrainer's columns plus ``opponent``,
 ``decisions`` and ``wall_s``, metrics/sessions.csv, metrics/updates.csv, model/ as ``save_tank_model`` writes

@@ -20,7 +20,8 @@ and ``PPO tanks - method`` paired over seeds (BCa interval, one-sided sign-flip 
 Writes ``compare.json`` and ``compare.md`` into ``--out``. Trained baselines and per-(method, seed) results are
 cached under ``--work`` (default ``runs/tank-compare``), so an interrupted comparison resumes.
 
-    python -m confront.experiments.tank_compare --from-report docs/results/tanks/results.json --engine robocode \
+    python -m confront.experiments.tank_compare --from-report docs/results/tanks/results.json \
+        --engine robocode \
         --out docs/results/tanks [--rounds 30] [--engine-seed 1]
 
 ``--engine robocode``: the same comparison in Robocode 1.9.3.9, paired over the report's engine runs (``seedK``:

@@ -123,7 +123,8 @@ def test_logged_decisions_equal_the_python_twin(install, tmp_path: Path) -> None
     props = (f"-Dconfront.tank.model={tmp_path / 'policy.txt'}", f"-Dconfront.tank.log={tmp_path / 'log'}",
              "-Dconfront.tank.log.detail=true", f"-Dconfront.scores={tmp_path / 'scores.txt'}")
     run = run_battle(scenario_battle("4v4", TANK_ROBOT, "SpinBot", rounds=1),
-                     EngineOptions(seed=3, nosecurity=True, extra_jvm_args=props), extra_robots=[jar],
+                     EngineOptions(seed=3, nosecurity=True, extra_jvm_args=props, cpu_constant_ms=100.0),
+                     extra_robots=[jar],
                      install=install)
     decisions = read_decisions(tmp_path / "log")
     names = {r["name"] for r in run.summary["robots"] if r["contestant"] == 0}

@@ -50,6 +50,9 @@ MateRow = Sequence[float]  # x, y, energy
 PLAYS = ("greedy", "sampled")  # TankPolicy.play: the first maximum of each head, or a draw from its softmax
 
 
+TANK_CPU_CONSTANT_MS = 10.0  # the robots' time per turn in tank battles (evaluation and engine training)
+
+
 def sample_heads(logits: np.ndarray, dims: Sequence[int], u: Sequence[float]) -> int:
     """Joint action with each head drawn from the softmax of its logits by one uniform draw in [0, 1): the
     first choice whose running sum of probabilities (exp(z - max z), divided by their sum, in float64) exceeds
@@ -300,7 +303,7 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
 
 
 def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,
-                         seed: int = 0, cpu_constant_ms: float = 10.0,
+                         seed: int = 0, cpu_constant_ms: float = TANK_CPU_CONSTANT_MS,
                          install: EngineInstall | None = None, opponent_policy: ExportedPolicy | None = None
                          ) -> tuple[BattleResults, float]:
     """Play the exported TankBot (a jar, no Python in the loop) for our side of ``scenario`` (``1v1``,

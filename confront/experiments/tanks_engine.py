@@ -51,7 +51,7 @@ from confront.engine.battle import SCENARIO_SIZES, BattleSpec, scenario_battle, 
 from confront.engine.export import export_robot
 from confront.engine.install import find_engine
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
-from confront.engine.tank_export import TANK_ROBOT, TankPolicy, export_tank_robot
+from confront.engine.tank_export import TANK_CPU_CONSTANT_MS, TANK_ROBOT, TankPolicy, export_tank_robot
 from confront.experiments.spec import SCRIPTED_BOTS, ExperimentConfig
 from confront.experiments.tanks import (
     PAPER_MOVE_OPPONENTS,
@@ -69,7 +69,6 @@ from confront.runs import Run
 __all__ = ["EngineTankTrainer", "Decision", "ScoreLog", "read_decisions", "read_scores", "episode_rewards",
            "pack_episodes", "engine_entries", "TANK_CPU_CONSTANT_MS", "DECISION_SUFFIX"]
 
-TANK_CPU_CONSTANT_MS = 10.0  # the robot time per turn of training battles (evaluate_tank_policy's default)
 DECISION_SUFFIX = ".decisions"  # TankBot.LOG_SUFFIX
 POLICY_BOT = "confront.PolicyBot"
 
@@ -334,9 +333,12 @@ class EngineTankTrainer:
         lengths: list[int] = []
         round_turns = res.summary["round_turns"]
         empty = ScoreLog(np.zeros(0, np.int64), np.zeros((0, len(robots)), bool), np.zeros((0, len(robots))))
+        ends: dict[int, int | None] = {}  # each round's deciding turn, found once for all its robots
         for (robot, rnd), eps in episodes.items():
             log = scores.get(rnd, empty)
-            end = log.decided(contestant)
+            if rnd not in ends:
+                ends[rnd] = log.decided(contestant)
+            end = ends[rnd]
             if end is None:  # not decided (the battle stopped): the round's last turn
                 end = int(round_turns[rnd]) if rnd < len(round_turns) else eps[-1].turn + 1
             k = log.at(end)

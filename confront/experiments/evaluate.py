@@ -43,8 +43,10 @@ def results_from_rows(rows: list[dict[str, Any]], names: tuple[str, str]) -> Bat
 
 
 def sim_evaluate(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: int, seed: int,
-                 td_model: str | None = None, battles: int = SIM_BATTLES) -> list[dict[str, Any]]:
-    """Play ``learner`` greedily (no exploration, no learning) against ``opponent`` in the simulator.
+                 td_model: str | None = None, battles: int = SIM_BATTLES, opponent_learner: Learner | None = None
+                 ) -> list[dict[str, Any]]:
+    """Play ``learner`` greedily (no exploration, no learning) against ``opponent`` in the simulator; ``"td"``:
+    the TD team of ``td_model``, or ``opponent_learner`` (greedy, e.g. the dodge's move values) when given.
 
     The rounds are shared out over the battles beforehand (``rounds // battles``, one more for the first
     ``rounds % battles``) and each battle's first rounds are kept: taking the first ``rounds`` rounds to
@@ -57,9 +59,12 @@ def sim_evaluate(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds:
     team = env.team_ids()
     side = Side(learner, ours=team == 0)
     if opponent == "td":
-        if not td_model:
+        if opponent_learner is not None:
+            side.opponent = opponent_learner
+        elif not td_model:
             raise FileNotFoundError("evaluating against the TD team needs the run's TD model (summary.json td_model)")
-        side.opponent, _ = load_model(td_model)
+        else:
+            side.opponent, _ = load_model(td_model)
         side.theirs = team != 0
     loop = Loop(env, side, seed=seed, learning=False)
     quota = [rounds // n_b + (b < rounds % n_b) for b in range(n_b)]

@@ -3,6 +3,8 @@
     python -m confront.experiments.tank_compare RUN [RUN ...] --out docs/results/tanks [--rounds 100]
     python -m confront.experiments.tank_compare --from-report docs/results/tanks/results.json --out ...
 
+(``--from-report``: PPO tanks' shares from a tank_report; paired over its runs' training seeds, ``seedK``.)
+
 Each RUN is a PPO tanks run (``confront train -c tanks --set train.seed=K``); its seed K is the pairing key.
 For every seed K the other methods are trained as ``confront reproduce baselines`` trains them (the paper's
 4v4 against the seed's TD team, 500 rounds, the paper's state and four moves, T = 10):
@@ -61,8 +63,9 @@ from confront.experiments.evaluate import exported_policy, sim_evaluate
 from confront.experiments.jobs import Job, run_jobs
 from confront.experiments.spec import ExperimentConfig, config_from_dict, load_toml
 from confront.experiments.stats import paired_comparison
-from confront.experiments.tanks import evaluate_tanks, load_tank_model, paper_move_robot
+from confront.experiments.tanks import evaluate_tanks, load_tank_model, paper_move_robot, paper_move_values
 from confront.learning.base import Learner
+from confront.learning.tabular import TabularQ
 
 __all__ = ["OURS", "METHODS", "compare_entries", "method_shares", "compare", "engine_policy",
            "engine_method_shares", "compare_engine", "write_markdown"]
@@ -75,13 +78,21 @@ ENGINE_SEED = 1  # the baselines' engine battle (tank_report played PPO tanks' a
 
 
 def compare_entries(opponents: tuple[str, ...]) -> list[str]:
-    """The league entries every method can play: a sample robot (1v1 or as a team) or the TD team."""
+    """The league entries every method can play: a sample robot (1v1 or as a team), the TD team or the dodge."""
     out = []
     for e in opponents:
         scen, _, opp = e.partition(":")
-        if scen in ("1v1", "4v4") and (opp in BOT_NAMES or (opp == "td" and scen == "4v4")):
+        if scen in ("1v1", "4v4") and (opp in BOT_NAMES or opp == "dodge" or (opp == "td" and scen == "4v4")):
             out.append(e)
     return out
+
+
+def dodge_learner() -> TabularQ:
+    """The hand-written dodge as a greedy table learner: its move values (:func:`tanks.paper_move_values`), the
+    two moves it draws from tied, so greedy play with random ties is the dodge's uniform draw."""
+    learner = TabularQ()
+    learner.q[...] = paper_move_values(baseline_experiment(BaselinesConfig(), 0, TRAIN_ROUNDS), "dodge")
+    return learner
 
 
 def _baseline_policy(method: str, seed: int, work: Path, td_name: str) -> tuple[Learner, ExperimentConfig]:
@@ -135,7 +146,9 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
     for e in entries:
         scen, _, opp = e.partition(":")
         cfg = replace(exp, arena=replace(exp.arena, scenario=scen))
-        rows = sim_evaluate(cfg, policy, opp, rounds, 10_000 + seed, td_model if opp == "td" else None)
+        rows = sim_evaluate(cfg, policy, "td" if opp == "dodge" else opp, rounds, 10_000 + seed,
+                            td_model if opp == "td" else None,
+                            opponent_learner=dodge_learner() if opp == "dodge" else None)
         shares[e] = pooled_ratio(rows)[2]
     done.parent.mkdir(parents=True, exist_ok=True)
     ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "td_team": td_name,
@@ -143,17 +156,26 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
     return shares
 
 
+def engine_paper_move_robot(exp: ExperimentConfig, opp: str) -> Any:
+    """A paper-move opponent (``"random"``, ``"dodge"``) as the engine's PolicyBot at the baselines' step length
+    and observation (:func:`tanks.paper_move_robot` with the baselines' experiment ``exp``)."""
+    from confront.experiments.episodes import smdp_config
+
+    return replace(paper_move_robot(exp, opp), observation=smdp_config(exp).observation,
+                   step_turns=exp.arena.decision_turns)
+
+
 def engine_policy(method: str, seed: int, work: Path, td_name: str) -> Any:
     """``method`` at ``seed`` as the engine's PolicyBot (an ExportedPolicy at the baselines' step length), trained
     by :func:`_baseline_policy` where it is not yet in ``work``: DMNN (FLM) greedy (``ExportedPolicy.from_learner``),
     SB3 PPO deterministic (:func:`sb3_exported_policy` of the kept ``policy.npz``), random moves as zero move
-    values with random ties (:func:`tanks.paper_move_robot`)."""
+    values with random ties (:func:`engine_paper_move_robot`)."""
     from confront.experiments.episodes import smdp_config
 
     exp = baseline_experiment(BaselinesConfig(), seed, TRAIN_ROUNDS)
     observation, step_turns = smdp_config(exp).observation, exp.arena.decision_turns
     if method == RANDOM_METHOD:
-        return replace(paper_move_robot(exp, "random"), observation=observation, step_turns=step_turns)
+        return engine_paper_move_robot(exp, "random")
     if method == SB3_PPO:
         folder = work / "sb3-ppo" / f"seed-{seed}"
         info = json.loads((folder / "train.json").read_text()) if (folder / "train.json").is_file() else {}
@@ -171,7 +193,8 @@ def engine_method_shares(method: str, seed: int, entries: list[str], td_model: s
                          engine_seed: int = ENGINE_SEED) -> dict[str, float]:
     """Share per entry of a baseline method at ``seed`` in Robocode: :func:`engine_policy` for our side, one
     battle of ``rounds`` rounds (engine seed ``engine_seed``) against the entry's sample robot(s) or the TD team
-    ``td_model`` (exported PolicyBots, greedy with random ties, at the baselines' step length). Each battle is
+    ``td_model`` or the dodge (exported PolicyBots, greedy with random ties, at the baselines' step length and
+    observation: :func:`engine_paper_move_robot`). Each battle is
     kept in ``work/engine`` as it ends; one of other rounds, engine seed or TD-team artefact is played again."""
     from confront.engine.evaluate import evaluate_policy
     from confront.experiments.episodes import load_model
@@ -181,18 +204,20 @@ def engine_method_shares(method: str, seed: int, entries: list[str], td_model: s
            "td_team": Path(td_model).name}
     cached = json.loads(path.read_text()) if path.is_file() else {}
     shares: dict[str, float] = dict(cached["shares"]) if all(cached.get(k) == v for k, v in key.items()) else {}
-    ours = theirs = None
+    ours = None
+    theirs: dict[str, Any] = {}
     for e in entries:
         if e in shares:
             continue
         scen, _, opp = e.partition(":")
         if ours is None:
             ours = engine_policy(method, seed, work, key["td_team"])
-        if opp == "td" and theirs is None:
+        if opp in ("td", "dodge") and opp not in theirs:
             exp = baseline_experiment(BaselinesConfig(), seed, TRAIN_ROUNDS)
-            theirs = replace(exported_policy(load_model(td_model)[0], exp), ties="random")
+            theirs[opp] = (replace(exported_policy(load_model(td_model)[0], exp), ties="random") if opp == "td"
+                           else engine_paper_move_robot(exp, opp))
         shares[e] = evaluate_policy(ours, scen, opp, rounds=rounds, seed=engine_seed,
-                                    opponent_policy=theirs if opp == "td" else None)[1]
+                                    opponent_policy=theirs.get(opp))[1]
         path.parent.mkdir(parents=True, exist_ok=True)
         ck.write_atomic(path, json.dumps({**key, "shares": shares}, indent=1).encode())
     return {e: shares[e] for e in entries}
@@ -258,14 +283,24 @@ def welch_greater(a: list[float], b: list[float]) -> dict[str, float]:
 
 def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], rounds: int = 100
                    ) -> dict[str, Any]:
-    """PPO tanks' greedy shares from a tank_report ``results.json`` (its training seeds) against the baselines
-    trained at ``base_seeds`` (``confront train -c tanks``'s TD team of each seed), unpaired: Welch's t."""
+    """PPO tanks' shares from a tank_report ``results.json`` against the baselines, per seed's TD team
+    (``confront train -c tanks``'s). When every run names its training seed (``seedK``) the baselines are trained at
+    those seeds and the comparison is paired over them (as ``--engine robocode``); otherwise at ``base_seeds``,
+    unpaired: Welch's t."""
     from confront.experiments.episodes import td_team
     from confront.experiments.spec import load_experiment
 
     rep = json.loads(results.read_text())
     if rep["rounds"] != rounds:
         raise ValueError(f"{results} evaluated {rep['rounds']} rounds per entry, this comparison {rounds}")
+    try:
+        seeds: list[int] | None = [run_seed(r) for r in rep["runs"]]
+    except ValueError:
+        seeds = None
+    if seeds is not None and len(set(seeds)) == len(seeds):
+        base_seeds = seeds
+    else:
+        seeds = None
     entries = compare_entries(tuple(r["entry"] for r in rep["rows"]))
     shares: dict[str, dict[str, list[float]]] = {OURS: {r["entry"]: r["sim"] for r in rep["rows"]
                                                         if r["entry"] in entries}}
@@ -276,9 +311,14 @@ def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], 
             got = method_shares(m, seed, entries, str(td_path), rounds, work)
             for e in entries:
                 shares[m][e].append(got[e])
-    tests = {m: {e: welch_greater(shares[OURS][e], shares[m][e]) for e in entries} for m in METHODS}
-    result = {"runs": rep["runs"], "seeds": rep["runs"], "base_seeds": base_seeds, "rounds": rounds,
-              "train_rounds": TRAIN_ROUNDS, "entries": entries, "shares": shares, "tests": tests, "test": "welch"}
+    result: dict[str, Any] = {"runs": rep["runs"], "base_seeds": base_seeds, "rounds": rounds,
+                              "train_rounds": TRAIN_ROUNDS, "entries": entries, "shares": shares,
+                              "play": rep.get("play", "greedy"), "ours_battle_seed": 10_000}
+    if seeds is not None:
+        result.update(seeds=seeds, tests=_paired_tests(shares, entries), test="paired")
+    else:
+        result.update(seeds=rep["runs"], test="welch",
+                      tests={m: {e: welch_greater(shares[OURS][e], shares[m][e]) for e in entries} for m in METHODS})
     out.mkdir(parents=True, exist_ok=True)
     (out / "compare.json").write_text(json.dumps(result, indent=1))
     write_markdown(result, out)
@@ -351,8 +391,9 @@ def write_markdown(result: dict[str, Any], out: Path, name: str = "compare.md") 
                "of the side it faces, as in the simulator comparison.",
                paired]
     elif result.get("test") == "welch":
-        how = [f"PPO tanks: training seeds {', '.join(map(str, seeds))} (greedy shares of the report, battle seed "
-               f"10000); the baselines: seeds {', '.join(map(str, result['base_seeds']))}, each trained "
+        how = [f"PPO tanks: training seeds {', '.join(map(str, seeds))} ({result.get('play', 'greedy')} shares of "
+               f"the report, battle seed 10000); the baselines: seeds {', '.join(map(str, result['base_seeds']))}, "
+               "each trained "
                f"{result['train_rounds']} rounds against that seed's TD team, as `confront reproduce baselines` "
                "(battle seed 10000 + seed). Simulator, greedy, "
                f"{result['rounds']} rounds per entry and seed.",
@@ -394,8 +435,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="*", type=Path)
     ap.add_argument("--from-report", type=Path, default=None, metavar="RESULTS_JSON",
-                    help="PPO tanks' shares from a tank_report results.json instead of RUNs (unpaired, Welch)")
-    ap.add_argument("--base-seeds", type=int, default=5, help="with --from-report: baseline seeds 0..N-1")
+                    help="PPO tanks' shares from a tank_report results.json instead of RUNs (paired over the runs' "
+                         "training seeds when they are named seedK, else unpaired: Welch)")
+    ap.add_argument("--base-seeds", type=int, default=5,
+                    help="with --from-report whose runs do not name their training seeds (seedK): baseline seeds "
+                         "0..N-1")
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--rounds", type=int, default=100)
     ap.add_argument("--work", type=Path, default=Path("runs") / "tank-compare")

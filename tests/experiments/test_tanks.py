@@ -136,7 +136,7 @@ def test_compare_entries_and_paired_verdicts(tmp_path) -> None:
     from confront.experiments.tank_compare import METHODS, OURS, compare_entries, write_markdown
 
     league = ("1v1:SpinBot", "1v1:dodge", "1v1:self", "4v4:td", "1v1:td", "4v4:Walls", "4v10:SpinBot")
-    assert compare_entries(league) == ["1v1:SpinBot", "4v4:td", "4v4:Walls"]
+    assert compare_entries(league) == ["1v1:SpinBot", "1v1:dodge", "4v4:td", "4v4:Walls"]
     # 5 seeds, ours ahead of every method by 0.1 on each: the sign-flip p is 1/32 (all 32 flips enumerated)
     from confront.experiments.stats import paired_comparison
 
@@ -337,12 +337,13 @@ def test_engine_comparison_pairs_each_seed_with_the_reports_engine_mean(tmp_path
 
     def shares(method, seed, entries, td_model, rounds, work, engine_seed):  # noqa: ANN001, ANN202
         calls.append((method, seed, td_model, rounds, engine_seed))
-        return {"1v1:SittingDuck": 1.0, "4v4:td": 0.5 + 0.1 * seed}  # 0.1 below PPO tanks' mean at every seed
+        # 0.1 below PPO tanks' mean at every seed
+        return {"1v1:SittingDuck": 1.0, "1v1:dodge": 0.5 + 0.1 * seed, "4v4:td": 0.5 + 0.1 * seed}
 
     monkeypatch.setattr(tc, "engine_method_shares", shares)
     monkeypatch.setattr(episodes, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
     res = tc.compare_engine(tmp_path / "results.json", tmp_path / "out", 7, tmp_path / "work")
-    assert res["seeds"] == [0, 1, 2, 3, 4] and res["entries"] == ["1v1:SittingDuck", "4v4:td"]
+    assert res["seeds"] == [0, 1, 2, 3, 4] and res["entries"] == ["1v1:SittingDuck", "1v1:dodge", "4v4:td"]
     assert calls[:3] == [(m, 0, "/c/td/t0", 7, 1) for m in tc.METHODS] and len(calls) == 15
     assert res["shares"][tc.OURS]["4v4:td"] == pytest.approx([0.6 + 0.1 * k for k in range(5)])
     for m in tc.METHODS:
@@ -354,11 +355,60 @@ def test_engine_comparison_pairs_each_seed_with_the_reports_engine_mean(tmp_path
     md = (tmp_path / "out" / "compare-engine.md").read_text()
     assert "the mean of 3 battles x 100 rounds (engine seeds 1-3)" in md
     assert "1 battle x 7 rounds (engine seed 1)" in md
-    assert "| 4v4:td | 0.800 | 0.700 | 0.700 | 0.700 |" in md and "DMNN (FLM) on 1 of 2 entries" in md
+    assert "| 4v4:td | 0.800 | 0.700 | 0.700 | 0.700 |" in md and "DMNN (FLM) on 2 of 3 entries" in md
     assert not (tmp_path / "out" / "compare.md").exists()
     assert tc.run_seed("seed3") == 3 and tc.run_seed("runs/tanks-seed-12") == 12
     with pytest.raises(ValueError, match="training seed"):
         tc.run_seed("shipped")
+
+
+def test_the_baselines_face_the_dodge_as_its_own_policy_draws() -> None:
+    from confront.experiments.tank_compare import dodge_learner
+    from confront.experiments.tanks import dodge_policy
+
+    states = np.repeat(np.arange(320), 200)
+    ours = dodge_learner().act(states, np.random.default_rng(1), explore=False)
+    theirs = dodge_policy(states, np.zeros((len(states), 1)), np.random.default_rng(2))
+    # the same two moves in each state, each drawn about half the time
+    c_ours = np.stack([np.bincount(ours[states == s], minlength=4) for s in range(320)])
+    c_theirs = np.stack([np.bincount(theirs[states == s], minlength=4) for s in range(320)])
+    assert np.array_equal(c_ours > 0, c_theirs > 0) and ((c_ours > 0).sum(axis=1) == 2).all()
+    assert c_ours[c_ours > 0].min() > 60  # 200 draws of two tied moves: about 100 each
+
+
+def test_report_comparison_pairs_named_seeds_and_falls_back_to_welch(tmp_path, monkeypatch) -> None:
+    from confront.experiments import episodes
+    from confront.experiments import tank_compare as tc
+
+    entries = ["1v1:SittingDuck", "4v4:td"]
+    # the report lists its runs seed4 .. seed0; run seedK's share is 0.6 + 0.1 K
+    rows = [{"entry": "1v1:SittingDuck", "sim": [1.0] * 5},
+            {"entry": "4v4:td", "sim": [1.0 - 0.1 * k for k in range(5)]}]
+    calls = []
+
+    def shares(method, seed, entries, td_model, rounds, work):  # noqa: ANN001, ANN202
+        calls.append((method, seed, td_model))
+        return {"1v1:SittingDuck": 1.0, "4v4:td": 0.5 + 0.1 * seed}  # 0.1 below PPO tanks' share at every seed
+
+    monkeypatch.setattr(tc, "method_shares", shares)
+    monkeypatch.setattr(episodes, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
+    for runs, seeds, test in (([f"seed{4 - k}" for k in range(5)], [4, 3, 2, 1, 0], "paired"),
+                              (["a", "b", "c", "d", "e"], [0, 1, 2, 3, 4], "welch")):
+        calls.clear()
+        (tmp_path / "results.json").write_text(json.dumps({"runs": runs, "rounds": 100, "play": "sampled",
+                                                           "rows": rows}))
+        res = tc.compare_report(tmp_path / "results.json", tmp_path / test, tmp_path / "work", [0, 1, 2, 3, 4])
+        assert res["test"] == test and res["base_seeds"] == seeds and res["entries"] == entries
+        assert calls[:3] == [(m, seeds[0], f"/c/td/t{seeds[0]}") for m in tc.METHODS] and len(calls) == 15
+        for m in tc.METHODS:
+            t = res["tests"][m]["4v4:td"]
+            assert t["diff"] == pytest.approx(0.1)
+            # paired by seed: +0.1 at each of 5 seeds, the smallest sign-flip p; unpaired: 0.1 against a 0.16 spread
+            assert t["p"] == pytest.approx(1 / 32, abs=0.01) if test == "paired" else t["p"] > 0.1
+        md = (tmp_path / test / "compare.md").read_text()
+        assert "sampled" in md and ("Welch" in md) == (test == "welch")
+    with pytest.raises(ValueError, match="evaluated 100 rounds"):
+        tc.compare_report(tmp_path / "results.json", tmp_path / "x", tmp_path / "work", [0], rounds=30)
 
 
 def test_report_curves_come_from_the_first_run_with_round_metrics(tmp_path, capsys) -> None:

@@ -22,7 +22,7 @@ from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
 C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = range(9)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndarray, tables: np.ndarray,
              n_act: np.ndarray, slots: np.ndarray, move: np.ndarray, power: np.ndarray, chosen: np.ndarray,
              active: np.ndarray) -> bool:
@@ -50,13 +50,13 @@ def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndar
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def _relative(a: float) -> float:
     """Angle wrapped to [-pi, pi) (Utils.normalRelativeAngle, as control._rel)."""
     return float_mod(a + np.pi, 2 * np.pi) - np.pi
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: float, ctrl: np.ndarray,
                     power: float, cmd: np.ndarray) -> None:
     """Gun turn, radar turn and fire power of a living learning tank (control.aim's rule) toward its
@@ -93,7 +93,7 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
         cmd[b, i, 4] = ctrl[C_PFAR]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, _nrt=False)
 def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem):
     """The scripted bots' decisions of battles b0..b1-1 (bots.bots_step on the arena's packed arrays)."""
     r = slice(b0, b1)
@@ -123,10 +123,25 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     run in parallel threads. Each robot picks its target and aims from its own picture
     (observe.perceive_row); after each turn the robots' scans go into ``memory``."""
     n = rf.shape[2]
-    vx, vy, ve, va = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    return _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory,
+                      sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
+                      score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width,
+                      height, buf, rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates,
+                      mates_ok, slots, view_mask, paper_mask, np.empty(n), np.empty(n), np.empty(n),
+                      np.empty(n, dtype=np.bool_), np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(feats.shape[2]),
+                      np.zeros(view.shape[2]), np.empty(n))
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
+               rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
+               placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
+               rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
+               view_mask, paper_mask, vx, vy, ve, va, before, gain, row, vrow, dist):
+    """:func:`_smdp_turns` with its scratch arrays given (vx, vy, ve, va, gain, dist (R,), before (b1 - b0, R),
+    row (F,) and vrow (view F,)): no allocation, so no reference counting of the many views it passes on."""
+    n = rf.shape[2]
     margin = ctrl[C_REWARD] > 0
-    before = np.zeros((b1 - b0, n))
-    gain = np.zeros(n)
     for t in range(t0, t1):
         any_live = False
         for b in range(b0, b1):
@@ -212,7 +227,6 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                                                           rf[b, K.E, tg], guard)
     # the paper's observations (observe.observe_kernel) of the robots in paper_mask; the others: target -1,
     # state 0, features 0
-    row = np.zeros(feats.shape[2])
     for b in range(b0, b1):
         for i in range(n):
             if not paper_mask[i]:
@@ -228,16 +242,15 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
             for q in range(row.shape[0]):
                 feats[b, i, q] = row[q]
     if k_slots > 0:  # the tank views of the robots in view_mask (the others' rows zero, no slots)
-        row = np.zeros(view.shape[2])
         for b in range(b0, b1):
             tb = float(bi[b, K.TIME])
             for i in range(n):
                 if view_mask[i]:
                     tank_view_row(rf[b, K.X], rf[b, K.Y], rf[b, K.H], rf[b, K.V], rf[b, K.E], rf[b, K.HEAT],
                                   rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b], scan_time[b], tb, width, height,
-                                  k_slots, m_slots, mates[b], mates_ok[b], row, slots[b, i])
-                    for q in range(row.shape[0]):
-                        view[b, i, q] = row[q]
+                                  k_slots, m_slots, mates[b], mates_ok[b], vrow, slots[b, i], dist)
+                    for q in range(vrow.shape[0]):
+                        view[b, i, q] = vrow[q]
                 else:
                     view[b, i, :] = 0.0
                     slots[b, i, :] = -1

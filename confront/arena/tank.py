@@ -151,7 +151,7 @@ def action_table(space: TankSpace) -> np.ndarray:
                      np.array([float(LEADS[v]) for v in space.leads])[lead]], axis=1)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, rate: float, age: float,
                power: float, width: float, height: float) -> tuple[float, float]:
     """Where to aim at an enemy last scanned at (mx, my) heading mh at velocity mv ``age`` turns ago, turning
@@ -180,12 +180,13 @@ def lead_point(x: float, y: float, mx: float, my: float, mh: float, mv: float, r
     return px, py
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e: np.ndarray, heat: np.ndarray,
                   alive: np.ndarray, team: np.ndarray, i: int, memory: np.ndarray, seen: np.ndarray, time: float,
                   width: float, height: float, k_slots: int, m_slots: int, mates: np.ndarray, mates_ok: bool,
-                  out: np.ndarray, slots: np.ndarray) -> None:
-    """Robot i's tank view of one battle's (R,) robots into ``out`` (F,), its enemy slots into ``slots`` (K,).
+                  out: np.ndarray, slots: np.ndarray, dist: np.ndarray) -> None:
+    """Robot i's tank view of one battle's (R,) robots into ``out`` (F,), its enemy slots into ``slots`` (K,);
+    ``dist`` (R,) is scratch.
 
     An enemy is known while alive and scanned this round (``seen[i, j] >= 0``), at ``memory[:, i, j]``
     (MEMORY_ROWS, R, R); a living team-mate at ``mates[:, j]`` (3, R): x, y, energy one turn ago (a team
@@ -220,7 +221,6 @@ def tank_view_row(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray, e:
     out[10] = n_mate_alive / n_mate if n_mate > 0 else 0.0
     # enemies: selection by distance to the remembered position (k_slots smallest, ties to the lower index)
     # (each distance computed once; a chosen or ineligible robot's is inf)
-    dist = np.empty(n)
     for j in range(n):
         if team[j] == team[i] or not alive[j] or seen[i, j] < 0:
             dist[j] = np.inf
@@ -280,11 +280,12 @@ def tank_view_kernel(x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray,
                      mates_ok: np.ndarray, feats: np.ndarray, slots: np.ndarray) -> None:
     """Tank views (B, R, F) and enemy slot maps (B, R, K) of every robot of (B, R) arrays; ``mates`` (B, 3, R)
     and ``mates_ok`` (B,) as in :func:`tank_view_row`."""
-    row = np.zeros(feats.shape[2])
+    row, dist = np.zeros(feats.shape[2]), np.empty(x.shape[1])
     for b in range(x.shape[0]):
         for i in range(x.shape[1]):
             tank_view_row(x[b], y[b], h[b], v[b], e[b], heat[b], alive[b], team[b], i, memory[b], seen[b],
-                          float(time[b]), width, height, k_slots, m_slots, mates[b], mates_ok[b], row, slots[b, i])
+                          float(time[b]), width, height, k_slots, m_slots, mates[b], mates_ok[b], row, slots[b, i],
+                          dist)
             for q in range(row.shape[0]):
                 feats[b, i, q] = row[q]
 

@@ -103,7 +103,7 @@ def robot_view(own: Sequence[float], counts: Sequence[int], enemies: Sequence[En
     slots = np.full(space.enemy_slots, -1, dtype=np.int64)
     tank_view_row(x, y, h, v, e, heat, np.ones(n, dtype=np.bool_), team, 0, memory, seen, float(time),
                   float(width), float(height), space.enemy_slots, space.mate_slots, np.stack([x, y, e]), True, out,
-                  slots)
+                  slots, np.empty(n))
     ea, es, ma, ms = counts  # the counts TankBot has (its mates' messages may be missing at turn 0)
     out[9] = ea / es if es > 0 else 0.0
     out[10] = ma / ms if ms > 0 else 0.0

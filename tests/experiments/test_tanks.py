@@ -28,7 +28,7 @@ def test_view_hand_computed() -> None:
     out, slots = np.zeros(11 + 9 * 2 + 5), np.zeros(2, dtype=np.int64)
     tank_view_row(x, y, h, np.array([-4.0, 0, 0]), np.array([60.0, 80, 90]), np.array([1.5, 0, 0]),
                   np.ones(3, bool), np.array([0, 1, 0]), 0, mem, seen, 10.0, 800.0, 600.0, 2, 1,
-                  np.stack([x, y, [60, 80, 90.0]]), True, out, slots)
+                  np.stack([x, y, [60, 80, 90.0]]), True, out, slots, np.empty(3))
     np.testing.assert_allclose(out[:11], [100 / 800, 100 / 600, 700 / 800, 500 / 600, 1.0, math.cos(math.pi / 2),
                                           -0.5, 0.6, 0.5, 1.0, 1.0], atol=1e-12)
     e = out[OWN_FEATURES:OWN_FEATURES + 9]

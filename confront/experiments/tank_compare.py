@@ -13,11 +13,12 @@ For every seed K the other methods are trained as ``confront reproduce baselines
 - ``PPO (SB3)``: Stable-Baselines3's PPO shared by the team's tanks (:func:`baselines.train_sb3`);
 - ``Random moves``: each tank picks one of the paper's four moves at random (no training).
 
-Then every method plays ``--rounds`` greedy rounds per league entry that names a sample robot or the TD team,
-in the simulator: PPO tanks through :func:`tanks.evaluate_tanks`, the others through
+Then every method plays ``--rounds`` greedy rounds per league entry that names a sample robot, the TD team or
+the dodge, in the simulator: PPO tanks through :func:`tanks.evaluate_tanks`, the others through
 :func:`evaluate.sim_evaluate` with the entry's scenario (1v1 or 4v4). Both sides of a seed face the same
-TD-team artefact (the PPO run's), each at its own step length. Per entry and method: the mean share over seeds
-and ``PPO tanks - method`` paired over seeds (BCa interval, one-sided sign-flip permutation p).
+TD-team artefact (the PPO run's) and the same dodge (:func:`dodge_learner`), each at its own step length. Per
+entry and method: the mean share over seeds and ``PPO tanks - method`` paired over seeds (BCa interval, one-sided
+sign-flip permutation p).
 
 Writes ``compare.json`` and ``compare.md`` into ``--out``. Trained baselines and per-(method, seed) results are
 cached under ``--work`` (default ``runs/tank-compare``), so an interrupted comparison resumes.

@@ -115,6 +115,8 @@ def _rad(d):
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _normal_relative_deg(a):
     """Utils.normalRelativeAngleDegrees: a % 360 into [-180, 180)."""
+    if -180.0 <= a < 180.0:  # fmod leaves these unchanged and the result is a itself; skip the slow call
+        return a
     a = np.fmod(a, 360.0)
     if a >= 0:
         return a if a < 180 else a - 360

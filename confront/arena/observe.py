@@ -92,6 +92,8 @@ def team_rows(team: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
 @njit(cache=True)
 def float_mod(a: float, m: float) -> float:
     """a mod m for m > 0 with the sign of m, computed exactly as Python's and NumPy's float % (fmod based)."""
+    if 0.0 <= a < m:  # fmod leaves such values unchanged; skip the slow call
+        return a
     r = np.fmod(a, m)
     if r < 0:
         r += m

@@ -88,11 +88,11 @@ def compare_entries(opponents: tuple[str, ...]) -> list[str]:
     return out
 
 
-def dodge_learner() -> TabularQ:
+def dodge_learner(exp: ExperimentConfig) -> TabularQ:
     """The hand-written dodge as a greedy table learner: its move values (:func:`tanks.paper_move_values`), the
     two moves it draws from tied, so greedy play with random ties is the dodge's uniform draw."""
     learner = TabularQ()
-    learner.q[...] = paper_move_values(baseline_experiment(BaselinesConfig(), 0, TRAIN_ROUNDS), "dodge")
+    learner.q[...] = paper_move_values(exp, "dodge")
     return learner
 
 
@@ -149,7 +149,7 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
         cfg = replace(exp, arena=replace(exp.arena, scenario=scen))
         rows = sim_evaluate(cfg, policy, "td" if opp == "dodge" else opp, rounds, 10_000 + seed,
                             td_model if opp == "td" else None,
-                            opponent_learner=dodge_learner() if opp == "dodge" else None)
+                            opponent_learner=dodge_learner(exp) if opp == "dodge" else None)
         shares[e] = pooled_ratio(rows)[2]
     done.parent.mkdir(parents=True, exist_ok=True)
     ck.write_atomic(done, json.dumps({"method": method, "seed": seed, "rounds": rounds, "td_team": td_name,
@@ -294,14 +294,9 @@ def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], 
     rep = json.loads(results.read_text())
     if rep["rounds"] != rounds:
         raise ValueError(f"{results} evaluated {rep['rounds']} rounds per entry, this comparison {rounds}")
-    try:
-        seeds: list[int] | None = [run_seed(r) for r in rep["runs"]]
-    except ValueError:
-        seeds = None
-    if seeds is not None and len(set(seeds)) == len(seeds):
+    seeds = _named_seeds(rep["runs"])
+    if seeds is not None:
         base_seeds = seeds
-    else:
-        seeds = None
     entries = compare_entries(tuple(r["entry"] for r in rep["rows"]))
     shares: dict[str, dict[str, list[float]]] = {OURS: {r["entry"]: r["sim"] for r in rep["rows"]
                                                         if r["entry"] in entries}}
@@ -324,6 +319,15 @@ def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], 
     (out / "compare.json").write_text(json.dumps(result, indent=1))
     write_markdown(result, out)
     return result
+
+
+def _named_seeds(runs: list[str]) -> list[int] | None:
+    """The runs' training seeds when every run names a distinct one (``seedK``), else None."""
+    try:
+        seeds = [run_seed(r) for r in runs]
+    except ValueError:
+        return None
+    return seeds if len(set(seeds)) == len(seeds) else None
 
 
 def run_seed(name: str) -> int:

@@ -367,7 +367,7 @@ def test_the_baselines_face_the_dodge_as_its_own_policy_draws() -> None:
     from confront.experiments.tanks import dodge_policy
 
     states = np.repeat(np.arange(320), 200)
-    ours = dodge_learner().act(states, np.random.default_rng(1), explore=False)
+    ours = dodge_learner(load_experiment("tanks", ())).act(states, np.random.default_rng(1), explore=False)
     theirs = dodge_policy(states, np.zeros((len(states), 1)), np.random.default_rng(2))
     # the same two moves in each state, each drawn about half the time
     c_ours = np.stack([np.bincount(ours[states == s], minlength=4) for s in range(320)])

@@ -151,7 +151,7 @@ class Arena:
         else:
             self._fixed, self._has_fixed = np.zeros((r, 3)), False
         width = max(r, self.state.n_bullet_slots) + 1
-        self._scratch_i = np.zeros((b, 5, width), dtype=np.int32)
+        self._scratch_i = np.zeros((b, 6, width), dtype=np.int32)
         self._scratch_f = np.zeros((b, 3, r), dtype=np.float64)
         p = self.state.packed
         self._args = ((p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],

@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, vectorize
+from numba import njit, types, vectorize
+from numba.extending import intrinsic
 
 from .kernel_cache import install
 
@@ -438,13 +439,34 @@ def _java_atan(x: float) -> float:
     return -r if x < 0.0 else r
 
 
-@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+@intrinsic
+def _bits(typingctx, x):  # noqa: ARG001 (numba's intrinsic signature)
+    """The IEEE 754 bits of a float64 as an int64 (a register move)."""
+    if x != types.float64:
+        return None
+
+    def codegen(context, builder, signature, args):  # noqa: ARG001
+        return builder.bitcast(args[0], context.get_value_type(types.int64))
+
+    return types.int64(types.float64), codegen
+
+
+@intrinsic
+def _from_bits(typingctx, b):  # noqa: ARG001
+    """The float64 whose IEEE 754 bits are the int64 b."""
+    if b != types.int64:
+        return None
+
+    def codegen(context, builder, signature, args):  # noqa: ARG001
+        return builder.bitcast(args[0], context.get_value_type(types.float64))
+
+    return types.float64(types.int64), codegen
+
+
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _high_word(a: float) -> int:
-    """The upper 32 bits of the IEEE representation of a positive finite double."""
-    if a < 2.2250738585072014e-308:  # subnormal: the bits are a * 2^1074
-        return int(math.ldexp(a, 1042))
-    m, e = math.frexp(a)
-    return ((e + 1022) << 20) + int((2.0 * m - 1.0) * 1048576.0)
+    """The upper 32 bits of the IEEE representation of a positive finite double (fdlibm's __HI)."""
+    return _bits(a) >> 32
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
@@ -482,12 +504,10 @@ def java_atan2(y: float, x: float) -> float:
     return (z - _PI_LO) - math.pi if yneg else math.pi - (z - _PI_LO)
 
 
-@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _from_high_word(hw: int) -> float:
     """The positive double whose upper 32 bits are hw and lower 32 bits zero."""
-    if hw < 0x00100000:
-        return math.ldexp(float(hw), -1042)
-    return math.ldexp(1.0 + (hw & 0xFFFFF) / 1048576.0, (hw >> 20) - 1023)
+    return _from_bits(np.int64(hw) << 32)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")

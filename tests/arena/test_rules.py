@@ -194,6 +194,15 @@ def test_hypot_is_javas_bit_for_bit(x, y, java):
     assert R.java_hypot(x, y) == java
 
 
+@pytest.mark.parametrize("a", [1.0, 0.75, 651.4651788786148, 1e300, 2.2250738585072014e-308, 2.225e-308, 5e-324,
+                               1.2345e-310, 3.0 * 2.0 ** -1060])
+def test_high_words_are_the_ieee_upper_32_bits(a):
+    bits = int(np.array(a).view(np.int64))
+    hw = R._high_word(a)
+    assert hw == bits >> 32
+    assert np.array(R._from_high_word(hw)).view(np.int64) == (bits >> 32) << 32  # lower word cleared
+
+
 def test_atan2_and_hypot_special_values_as_java():
     pi = math.pi
     assert R.java_atan2(0.0, -1.0) == pi and R.java_atan2(-0.0, -1.0) == -pi

@@ -33,6 +33,7 @@ from .rules import (
     bullet_speed,
     clamp_power,
     distance_until_stop,
+    float_bits,
     gun_heat,
     is_near,
     java_atan2,
@@ -84,6 +85,9 @@ B_NONE, B_FIRED, B_MOVING, B_HIT_VICTIM, B_HIT_BULLET, B_HIT_WALL, B_EXPLODED = 
 BULLET_EXPLOSION = 17  # BulletPeer.EXPLOSION_LENGTH
 ROBOT_EXPLOSION = 71  # ExplosionPeer.EXPLOSION_LENGTH
 HALT_TURNS = 120  # robots halted when endTimer > 4 * TURNS_DISPLAYED_AFTER_ENDING (Battle.shutdownTurn)
+# the float scratch ``last`` (B, 9, R): rows 0-2 this turn's gun and radar headings before turning and the scan flag;
+# rows 3-5 and 6-8 (angle, sin, cos) of the radar's last sweep end and of the body heading last moved along (_sin_cos)
+TRIG_RADAR, TRIG_BODY = 3, 6
 
 # params vector
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
@@ -481,7 +485,21 @@ def _turn_radar(rf, b, i):
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
-def _move(rf, rb, b, i):
+def _sin_cos(a, cache, b, row, i):
+    """sin(a), cos(a), taken from cache[b, row + 1 : row + 3, i] when cache[b, row, i] holds a bit for bit (a
+    heading that did not turn, a radar sweep starting where the last one ended), else computed and kept there."""
+    if float_bits(cache[b, row, i]) == float_bits(a):
+        return cache[b, row + 1, i], cache[b, row + 2, i]
+    sa = math.sin(a)
+    ca = math.cos(a)
+    cache[b, row, i] = a
+    cache[b, row + 1, i] = sa
+    cache[b, row + 2, i] = ca
+    return sa, ca
+
+
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
+def _move(rf, rb, b, i, last):
     """RobotPeer.updateMovement: getNewVelocity, overdrive flag, remaining distance, position, box."""
     d = rf[b, DIST, i]
     if math.isnan(d):
@@ -495,8 +513,9 @@ def _move(rf, rb, b, i):
         rb[b, OVERDRIVE, i] = distance_until_stop(v) > abs(d)
     rf[b, DIST, i] = d - v
     if v != 0.0:
-        rf[b, X, i] += v * math.sin(rf[b, H, i])
-        rf[b, Y, i] += v * math.cos(rf[b, H, i])
+        sh, ch = _sin_cos(rf[b, H, i], last, b, TRIG_BODY, i)
+        rf[b, X, i] += v * sh
+        rf[b, Y, i] += v * ch
         rf[b, BX, i] = rf[b, X, i]
         rf[b, BY, i] = rf[b, Y, i]
 
@@ -564,7 +583,7 @@ def _perform_move(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, last,
         _turn_body(rf, rb, b, i)
     _turn_gun(rf, rb, b, i)
     _turn_radar(rf, b, i)
-    _move(rf, rb, b, i)
+    _move(rf, rb, b, i, last)
     hit, nx, ny, ang = wall_correction(rf[b, X, i], rf[b, Y, i], rf[b, H, i], params[P_W], params[P_H])
     if hit:
         rb[b, EVWALL, i] = True
@@ -669,12 +688,10 @@ def _perform_scan(rf, rb, bi, scanned, scan_time, scan_order, perm_r, last, b, i
             ext += TWO_PI
         elif ext > math.pi:
             ext -= TWO_PI
-        ux = math.sin(start)
-        uy = math.cos(start)
+        ux, uy = _sin_cos(start, last, b, TRIG_RADAR, i)
         vx, vy = ux, uy  # sin/cos of start + 0.0: the same values
         if ext != 0.0:
-            vx = math.sin(start + ext)
-            vy = math.cos(start + ext)
+            vx, vy = _sin_cos(start + ext, last, b, TRIG_RADAR, i)  # usually the next turn's start
         xi = rf[b, X, i] + ROBOT_HALF
         yi = rf[b, Y, i] + ROBOT_HALF
         for j in range(n):

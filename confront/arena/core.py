@@ -152,7 +152,8 @@ class Arena:
             self._fixed, self._has_fixed = np.zeros((r, 3)), False
         width = max(r, self.state.n_bullet_slots) + 1
         self._scratch_i = np.zeros((b, 6, width), dtype=np.int32)
-        self._scratch_f = np.zeros((b, 3, r), dtype=np.float64)
+        self._scratch_f = np.zeros((b, 9, r), dtype=np.float64)
+        self._scratch_f[:, [K.TRIG_RADAR, K.TRIG_BODY]] = np.nan  # no sin/cos kept yet (_kernels._sin_cos)
         p = self.state.packed
         self._args = ((p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
                        p["scan_time"], p["scan_order"], p["damage_ledger"], p["score"], p["score_total"],

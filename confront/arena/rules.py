@@ -440,7 +440,7 @@ def _java_atan(x: float) -> float:
 
 
 @intrinsic
-def _bits(typingctx, x):  # noqa: ARG001 (numba's intrinsic signature)
+def float_bits(typingctx, x):  # noqa: ARG001 (numba's intrinsic signature)
     """The IEEE 754 bits of a float64 as an int64 (a register move)."""
     if x != types.float64:
         return None
@@ -452,7 +452,7 @@ def _bits(typingctx, x):  # noqa: ARG001 (numba's intrinsic signature)
 
 
 @intrinsic
-def _from_bits(typingctx, b):  # noqa: ARG001
+def float_from_bits(typingctx, b):  # noqa: ARG001
     """The float64 whose IEEE 754 bits are the int64 b."""
     if b != types.int64:
         return None
@@ -466,7 +466,7 @@ def _from_bits(typingctx, b):  # noqa: ARG001
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _high_word(a: float) -> int:
     """The upper 32 bits of the IEEE representation of a positive finite double (fdlibm's __HI)."""
-    return _bits(a) >> 32
+    return float_bits(a) >> 32
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
@@ -507,7 +507,7 @@ def java_atan2(y: float, x: float) -> float:
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _from_high_word(hw: int) -> float:
     """The positive double whose upper 32 bits are hw and lower 32 bits zero."""
-    return _from_bits(np.int64(hw) << 32)
+    return float_from_bits(np.int64(hw) << 32)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")

@@ -737,7 +737,7 @@ def _clear_events(b, i, rb, ri, scanned, rf):
         scanned[b, i, j] = False
 
 
-@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
                  placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order, near):
     """One Robocode turn of battle b (Battle.runTurn)."""

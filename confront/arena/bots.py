@@ -665,7 +665,7 @@ def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, c
                 _h(mem, b, i, O_FIREASSIST, p)
 
 
-@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _bots_battle(b, kinds, mem, x, y, h, gh, rh, energy, alive, team, dist_rem, body_rem, gun_rem, radar_rem, maxv,
                  assist, scan_req, scanned, ev_wall, ev_robot, ev_robot_bearing, ev_fault, ev_hitby,
                  ev_hitby_bearing, ev_hitby_heading, ev_died, width, height, cmd, rem, hr, hb, has_hr, heat,

@@ -120,7 +120,7 @@ def absolute_bearing(x: np.ndarray, y: np.ndarray, tx: np.ndarray, ty: np.ndarra
 TARGET_RULES: dict[str, int] = {"nearest": 0, "weakest": 1}
 
 
-@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
+@njit(cache=True, forceinline=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def target_of(x: np.ndarray, y: np.ndarray, energy: np.ndarray, alive: np.ndarray, team: np.ndarray,
               i: int, rule: int) -> int:
     """Target of robot i among the (R,) rows: nearest living enemy (rule 0), or least energy then nearest
@@ -280,7 +280,7 @@ def reward_eq35(
 reward_eq35_scalar = njit(cache=True)(reward_eq35)  # the same rule compiled for the SMDP kernel
 
 
-@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
+@njit(cache=True, forceinline=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def remember_scans(scanned: np.ndarray, x: np.ndarray, y: np.ndarray, e: np.ndarray, h: np.ndarray, v: np.ndarray,
                    time: float, memory: np.ndarray) -> None:
     """Store, for one battle, what each robot's radar saw this turn: memory[:, i, j] = (x, y, energy) of j
@@ -309,7 +309,7 @@ def remember_scans(scanned: np.ndarray, x: np.ndarray, y: np.ndarray, e: np.ndar
                 memory[2, i, j] = e[j]
 
 
-@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
+@njit(cache=True, forceinline=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def perceive_row(x: np.ndarray, y: np.ndarray, e: np.ndarray, alive: np.ndarray, team: np.ndarray, i: int,
                  memory: np.ndarray, seen: np.ndarray, sensing: int, vx: np.ndarray, vy: np.ndarray,
                  ve: np.ndarray, va: np.ndarray) -> None:

@@ -56,7 +56,7 @@ def _relative(a: float) -> float:
     return float_mod(a + np.pi, 2 * np.pi) - np.pi
 
 
-@njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
+@njit(cache=True, forceinline=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
 def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: float, ctrl: np.ndarray,
                     power: float, cmd: np.ndarray) -> None:
     """Gun turn, radar turn and fire power of a living learning tank (control.aim's rule) toward its

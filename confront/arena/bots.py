@@ -530,7 +530,7 @@ def _head(mem, b, i):
     return best
 
 
-@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _dispatch(kind, mem, b, i, k, x, y, h, gh, rh, energy, alive, team, kinds, cmd):
     """Start the handler of queued event k (removed from the queue): its level and operations."""
     e = M_EVQ + k * E_SIZE

@@ -270,8 +270,8 @@ def _remove_from_list(ki, bi, b, pos):
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm_k, b, s, params, bb_decided, near):
-    """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test (only
-    when near[s]: see _mark_near)."""
+    """BulletPeer.update for slot s: move, wall test, robot test (segment vs box), bullet-bullet test (the
+    candidates from _mark_near's pairs in ``near``)."""
     mode = int(params[P_ORDER])
     n = rf.shape[2]
     # the engine draws a robot order and a bullet order for every entry, used or not; the orders
@@ -361,28 +361,23 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
                     kf[b, KX, s] = lx
                     kf[b, KY, s] = ly
                 break
-        if (st == B_FIRED or st == B_MOVING) and near[s]:
+        if st == B_FIRED or st == B_MOVING:
             cand = 0
-            for q in range(nbk):
-                s2 = ki[b, KLIST, q]
-                # segments of at most 19.7 whose start points are 40 apart cannot cross
-                if abs(kf[b, KLX, s2] - lx) >= 40.0 or abs(kf[b, KLY, s2] - ly) >= 40.0:
-                    continue
-                st2 = ki[b, KSTATE, s2]
-                if s2 != s and (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KLINE, s2] != 0 and \
-                        ki[b, KOWNER, s2] != owner and segments_intersect(
-                            lx, ly, x, y, kf[b, KLX, s2], kf[b, KLY, s2], kf[b, KX, s2], kf[b, KY, s2]):
-                    cand += 1
+            pairs = near[0]
+            if pairs < 0:  # more pairs than _mark_near could list: look at every listed bullet
+                for q in range(nbk):
+                    if _bullets_meet(kf, ki, b, s, ki[b, KLIST, q], owner, lx, ly, x, y):
+                        cand += 1
+            for p in range(pairs):  # the bullets another owner's bullet is near to (each pair listed once)
+                if near[1 + 2 * p] == s:
+                    cand += _bullets_meet(kf, ki, b, s, near[2 + 2 * p], owner, lx, ly, x, y)
+                elif near[2 + 2 * p] == s:
+                    cand += _bullets_meet(kf, ki, b, s, near[1 + 2 * p], owner, lx, ly, x, y)
             if cand >= 2:
                 shuffle_into(rng1, perm_k, nbk, mode)
             for q in range(nbk if cand > 0 else 0):
                 s2 = ki[b, KLIST, perm_k[q] if cand >= 2 else q]
-                st2 = ki[b, KSTATE, s2]
-                if s2 == s or (st2 != B_FIRED and st2 != B_MOVING) or ki[b, KLINE, s2] == 0:
-                    continue
-                if ki[b, KOWNER, s2] == owner:
-                    continue
-                if segments_intersect(lx, ly, x, y, kf[b, KLX, s2], kf[b, KLY, s2], kf[b, KX, s2], kf[b, KY, s2]):
+                if _bullets_meet(kf, ki, b, s, s2, owner, lx, ly, x, y):
                     st = B_HIT_BULLET
                     ki[b, KFRAME, s] = 0
                     kf[b, KX, s] = lx
@@ -403,15 +398,29 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
-def _mark_near(kf, ki, b, nb, near):
-    """near[s] = 1 for the listed bullets that can meet a bullet of another owner this turn, else 0.
+def _bullets_meet(kf, ki, b, s, s2, owner, lx, ly, x, y):
+    """Bullet s (owner, moving from (lx, ly) to (x, y) this turn) crosses listed bullet s2's line
+    (BulletPeer.checkBulletCollision)."""
+    # segments of at most 19.7 whose start points are 40 apart cannot cross
+    if abs(kf[b, KLX, s2] - lx) >= 40.0 or abs(kf[b, KLY, s2] - ly) >= 40.0:
+        return False
+    st2 = ki[b, KSTATE, s2]
+    return s2 != s and (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KLINE, s2] != 0 and \
+        ki[b, KOWNER, s2] != owner and segments_intersect(lx, ly, x, y, kf[b, KLX, s2], kf[b, KLY, s2],
+                                                         kf[b, KX, s2], kf[b, KY, s2])
 
-    _update_bullet's bullet test looks only at lines starting within 40 px of its own start; every line of this
-    turn starts at most 19.7 px (one step) from its bullet's point before the turn's bullet updates, so two
-    bullets whose points are 60 px apart on an axis cannot meet: the test's result, hence the battle, is unchanged.
+
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
+def _mark_near(kf, ki, b, nb, near):
+    """The pairs of listed bullets of different owners that can meet this turn: near[0] pairs, the p-th in
+    near[1 + 2p], near[2 + 2p] (near[0] = -1 when they do not fit: then every bullet looks at every other).
+
+    _bullets_meet looks only at lines starting within 40 px of its bullet's start; every line of this turn starts at
+    most 19.7 px (one step) from its bullet's point before the turn's bullet updates, so two bullets whose points are
+    60 px apart on an axis cannot meet: the candidates, hence the battle, are unchanged.
     """
-    for q in range(nb):
-        near[ki[b, KLIST, q]] = 0
+    cap = (near.shape[0] - 1) // 2
+    pairs = 0
     for p in range(nb):
         s = ki[b, KLIST, p]
         st = ki[b, KSTATE, s]
@@ -425,8 +434,13 @@ def _mark_near(kf, ki, b, nb, near):
             if abs(kf[b, KX, s2] - x) < 60.0 and abs(kf[b, KY, s2] - y) < 60.0:
                 st2 = ki[b, KSTATE, s2]
                 if (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KOWNER, s2] != o:
-                    near[s] = 1
-                    near[s2] = 1
+                    if pairs == cap:
+                        near[0] = -1
+                        return
+                    near[1 + 2 * pairs] = s
+                    near[2 + 2 * pairs] = s2
+                    pairs += 1
+    near[0] = pairs
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")

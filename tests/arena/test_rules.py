@@ -157,6 +157,41 @@ def test_next_int_rejection_and_skip_match_java():
     assert R.java_next_int(s, 7)[0] != R.java_next(s, 31)[0]
 
 
+def test_shuffle_and_skips_match_collections_shuffle():
+    """shuffle_into and the jump-ahead skip equal Collections.shuffle step by step, also when a draw is rejected."""
+    from confront.arena._kernels import shuffle_into, skip_shuffle
+
+    mult, mask = 0x5DEECE66D, (1 << 48) - 1
+    back = pow(mult, -1, 1 << 48)
+
+    def shuffle_reference(state: int, n: int) -> tuple[int, list[int]]:
+        perm = list(range(n))
+        for i in range(n, 1, -1):
+            state, j = _java_next_int_reference(state, i)
+            perm[i - 1], perm[j] = perm[j], perm[i - 1]
+        return state, perm
+
+    rng = np.random.default_rng(3)
+    states = [int(v) for v in rng.integers(0, 1 << 48, 300)]
+    for k in range(6):  # the (k+1)-th draw of a shuffle of 7 is nextInt(7 - k): 2^31 - 1 is rejected (not 6 - k = 4)
+        s = _state_before((1 << 31) - 1)
+        for _ in range(k):
+            s = ((s - 0xB) * back) & mask
+        states.append(s)
+    perm = np.zeros(40, dtype=np.int32)
+    rejected = 0
+    for s in states:
+        for n in (1, 2, 3, 7, 8, 13, 40):
+            want_state, want_perm = shuffle_reference(s, n)
+            assert shuffle_into(s, perm, n, 0) == want_state
+            assert perm[:n].tolist() == want_perm
+            assert skip_shuffle(s, n, 0) == want_state
+            rejected += want_state != ((s * pow(mult, max(n - 1, 0), 1 << 48)
+                                        + sum(0xB * pow(mult, e, 1 << 48) for e in range(max(n - 1, 0)))) & mask)
+    assert rejected >= 6  # the constructed states do exercise the rejection path
+    assert shuffle_into(states[0], perm, 7, 2) == states[0] and perm[:7].tolist() == list(range(7))
+
+
 # Math.atan2 / Math.hypot as OpenJDK 17 computes them (fdlibm), for offsets where the C library's result is an
 # ulp away; the first two atan2 rows are from the engine traces (TrackFire to RamFire, seed 1 turn 78; RamFire's
 # collision with TrackFire, seed 2 turn 93), the rest from random offsets within 800 px

@@ -215,6 +215,19 @@ class TeamBattleEnv:
         # robots whose paper observation (target, discrete state, paper features) is computed; the others get
         # target -1, state 0, features 0 (a pool sets the robots its opponent policies read)
         self.paper_robots = np.ones(r, dtype=np.bool_)
+        self._group = 16
+
+    @property
+    def battle_group(self) -> int:
+        """Battles the kernel steps together, turn by turn (their arrays stay in cache): results do not depend on
+        it, speed does (16 was fastest of 4-32 on 256 and 1024 battles)."""
+        return self._group
+
+    @battle_group.setter
+    def battle_group(self, value: int) -> None:
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+            raise ValueError(f"battle_group must be a positive integer, got {value!r}")
+        self._group = int(value)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -402,7 +415,7 @@ class TeamBattleEnv:
         tank = self.config.tank
         view = (tank.enemy_slots, tank.mate_slots) if tank is not None else (0, 0)
         tail = (rewards, self.max_distance, *obs, *view, self._mates, self._mates_ok, self._slots, self.view_robots,
-                self.paper_robots)
+                self.paper_robots, self._group)
         ranges = [(0, self.n_battles)] if whole else self._ranges
         calls = [(lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
                  for k, (lo, hi) in enumerate(ranges)]

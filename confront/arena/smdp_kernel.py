@@ -111,7 +111,7 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                 rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
                 placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
                 rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
-                view_mask, paper_mask):
+                view_mask, paper_mask, group):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
     per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of
@@ -129,7 +129,102 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
                       height, buf, rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates,
                       mates_ok, slots, view_mask, paper_mask, np.empty(n), np.empty(n), np.empty(n),
                       np.empty(n, dtype=np.bool_), np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(feats.shape[2]),
-                      np.zeros(view.shape[2]), np.empty(n))
+                      np.zeros(view.shape[2]), np.empty(n), group,
+                      np.empty(-(-(b1 - b0) // group), dtype=np.int64))
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _smdp_turn(b0, b1, t, force, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
+               rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
+               placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf, rewards, k_slots,
+               mates, mates_ok, vx, vy, ve, va, before, gain):
+    """Turn t of an SMDP step for battles b0..b1-1: the learning tanks' commands (battles done: buf[3] zero),
+    then, unless every battle is done (and not ``force``), the bots, one Robocode turn, scan memory and rewards.
+    Returns False when it stopped because every battle was done."""
+    n = rf.shape[2]
+    margin = ctrl[C_REWARD] > 0
+    any_live = False
+    for b in range(b0, b1):
+        if bb[b, K.DONE]:
+            buf[3, b, :] = 0.0
+            continue
+        any_live = True
+        for i in range(n):
+            if margin and not learner[i]:  # a scripted robot's target and energies feed only Eq. 35 rewards
+                for c in range(4):
+                    cmd[b, i, c] = np.nan
+                cmd[b, i, 4] = 0.0
+                continue
+            perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
+                         scan_time[b], sensing, vx, vy, ve, va)
+            tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
+            c = chosen[b, i]
+            if c >= 0 and va[c]:
+                tg = c
+            buf[0, b, i] = tg
+            buf[1, b, i] = rf[b, K.E, i]
+            buf[2, b, i] = rf[b, K.E, tg] if tg >= 0 else 0.0
+            buf[3, b, i] = 1.0 if rb[b, K.ALIVE, i] and tg >= 0 else 0.0
+            if learner[i]:
+                # moves are written once at the start of the SMDP step (set* semantics), then kept
+                cmd[b, i, 0] = move[b, i, 0] if t == 0 else np.nan
+                cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
+                if t == 0 and move[b, i, 2] > 0 and tg >= 0:  # turn relative to the target's bearing
+                    bearing = java_atan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
+                    cmd[b, i, 1] = _relative(bearing + move[b, i, 1] - rf[b, K.H, i])
+                cmd[b, i, 2] = np.nan
+                cmd[b, i, 3] = np.nan
+                cmd[b, i, 4] = 0.0
+                if rb[b, K.ALIVE, i]:
+                    tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
+                    if tg >= 0 and move[b, i, 3] > 0 and sensing == 1:
+                        aim_power = power[b, i] if power[b, i] > 0 else 2.0
+                        rate = memory[b, M_TURN, i, tg] if move[b, i, 3] > 1 else 0.0
+                        tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, M_H, i, tg],
+                                            memory[b, M_V, i, tg], rate,
+                                            float(bi[b, K.TIME] - scan_time[b, i, tg]), aim_power, width, height)
+                    controller_turn(rf, b, i, tg, tx, ty, ctrl, power[b, i], cmd)
+            else:
+                for c in range(4):
+                    cmd[b, i, c] = np.nan
+                cmd[b, i, 4] = 0.0
+    if not any_live and not force:
+        return False
+    if has_bots:
+        _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem)
+    if k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
+        for b in range(b0, b1):
+            mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
+            for i in range(n):
+                mates[b, 0, i] = rf[b, K.X, i]
+                mates[b, 1, i] = rf[b, K.Y, i]
+                mates[b, 2, i] = rf[b, K.E, i]
+                if margin:
+                    before[b - b0, i] = score[b, i].sum()
+    # one Robocode turn of these battles (what Arena.step runs)
+    K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
+                 score_total,
+                 placements, placements_total, cmd, params, scratch_i, scratch_f)
+    for b in range(b0, b1):
+        remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],
+                       float(bi[b, K.TIME]), memory[b])
+        if margin:
+            for j in range(n):  # each robot's score change this turn
+                gain[j] = score[b, j].sum() - before[b - b0, j]
+            for i in range(n):
+                if not learner[i]:
+                    continue
+                m = 0.0
+                for j in range(n):
+                    m += gain[j] if ri[b, K.TEAM, j] == ri[b, K.TEAM, i] else -gain[j]
+                rewards[b, i, t] = m
+            continue
+        for i in range(n):
+            if buf[3, b, i] > 0:
+                tg = int(buf[0, b, i])
+                rewards[b, i, t] = reward_eq35_scalar(buf[1, b, i], rf[b, K.E, i], buf[2, b, i],
+                                                      rf[b, K.E, tg], guard)
+    return True
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -137,94 +232,38 @@ def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, powe
                rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
                placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
                rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
-               view_mask, paper_mask, vx, vy, ve, va, before, gain, row, vrow, dist):
+               view_mask, paper_mask, vx, vy, ve, va, before, gain, row, vrow, dist, group, stops):
     """:func:`_smdp_turns` with its scratch arrays given (vx, vy, ve, va, gain, dist (R,), before (b1 - b0, R),
-    row (F,) and vrow (view F,)): no allocation, so no reference counting of the many views it passes on."""
+    row (F,), vrow (view F,) and stops (groups,)): no allocation, so no reference counting of the many views it
+    passes on."""
     n = rf.shape[2]
-    margin = ctrl[C_REWARD] > 0
-    for t in range(t0, t1):
-        any_live = False
-        for b in range(b0, b1):
-            if bb[b, K.DONE]:
-                buf[3, b, :] = 0.0
-                continue
-            any_live = True
-            for i in range(n):
-                if margin and not learner[i]:  # a scripted robot's target and energies feed only Eq. 35 rewards
-                    for c in range(4):
-                        cmd[b, i, c] = np.nan
-                    cmd[b, i, 4] = 0.0
-                    continue
-                perceive_row(rf[b, K.X], rf[b, K.Y], rf[b, K.E], rb[b, K.ALIVE], ri[b, K.TEAM], i, memory[b],
-                             scan_time[b], sensing, vx, vy, ve, va)
-                tg = target_of(vx, vy, ve, va, ri[b, K.TEAM], i, rule)
-                c = chosen[b, i]
-                if c >= 0 and va[c]:
-                    tg = c
-                buf[0, b, i] = tg
-                buf[1, b, i] = rf[b, K.E, i]
-                buf[2, b, i] = rf[b, K.E, tg] if tg >= 0 else 0.0
-                buf[3, b, i] = 1.0 if rb[b, K.ALIVE, i] and tg >= 0 else 0.0
-                if learner[i]:
-                    # moves are written once at the start of the SMDP step (set* semantics), then kept
-                    cmd[b, i, 0] = move[b, i, 0] if t == 0 else np.nan
-                    cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
-                    if t == 0 and move[b, i, 2] > 0 and tg >= 0:  # turn relative to the target's bearing
-                        bearing = java_atan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
-                        cmd[b, i, 1] = _relative(bearing + move[b, i, 1] - rf[b, K.H, i])
-                    cmd[b, i, 2] = np.nan
-                    cmd[b, i, 3] = np.nan
-                    cmd[b, i, 4] = 0.0
-                    if rb[b, K.ALIVE, i]:
-                        tx, ty = (vx[tg], vy[tg]) if tg >= 0 else (0.0, 0.0)
-                        if tg >= 0 and move[b, i, 3] > 0 and sensing == 1:
-                            aim_power = power[b, i] if power[b, i] > 0 else 2.0
-                            rate = memory[b, M_TURN, i, tg] if move[b, i, 3] > 1 else 0.0
-                            tx, ty = lead_point(rf[b, K.X, i], rf[b, K.Y, i], tx, ty, memory[b, M_H, i, tg],
-                                                memory[b, M_V, i, tg], rate,
-                                                float(bi[b, K.TIME] - scan_time[b, i, tg]), aim_power, width, height)
-                        controller_turn(rf, b, i, tg, tx, ty, ctrl, power[b, i], cmd)
-                else:
-                    for c in range(4):
-                        cmd[b, i, c] = np.nan
-                    cmd[b, i, 4] = 0.0
-        if not any_live:
-            t1 = t
-            break
-        if has_bots:
-            _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem)
-        if k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
-            for b in range(b0, b1):
-                mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
-                for i in range(n):
-                    mates[b, 0, i] = rf[b, K.X, i]
-                    mates[b, 1, i] = rf[b, K.Y, i]
-                    mates[b, 2, i] = rf[b, K.E, i]
-                    if margin:
-                        before[b - b0, i] = score[b, i].sum()
-        # one Robocode turn of these battles (what Arena.step runs)
-        K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
-                     score_total,
-                     placements, placements_total, cmd, params, scratch_i, scratch_f)
-        for b in range(b0, b1):
-            remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],
-                           float(bi[b, K.TIME]), memory[b])
-            if margin:
-                for j in range(n):  # each robot's score change this turn
-                    gain[j] = score[b, j].sum() - before[b - b0, j]
-                for i in range(n):
-                    if not learner[i]:
-                        continue
-                    m = 0.0
-                    for j in range(n):
-                        m += gain[j] if ri[b, K.TEAM, j] == ri[b, K.TEAM, i] else -gain[j]
-                    rewards[b, i, t] = m
-                continue
-            for i in range(n):
-                if buf[3, b, i] > 0:
-                    tg = int(buf[0, b, i])
-                    rewards[b, i, t] = reward_eq35_scalar(buf[1, b, i], rf[b, K.E, i], buf[2, b, i],
-                                                          rf[b, K.E, tg], guard)
+    # battles in groups of ``group`` (their arrays stay in cache over the step's turns), each group turn by turn; a
+    # group whose battles are all done stops, and once the step's last turn is known (the first turn at which every
+    # battle was done) it is given the turns it missed, as the turn-by-turn order over all battles would have: the
+    # results do not depend on the group size
+    t_end = t0
+    for g in range(stops.shape[0]):
+        g0 = b0 + g * group
+        g1 = min(b1, g0 + group)
+        stops[g] = t1
+        for t in range(t0, t1):
+            if not _smdp_turn(g0, g1, t, False, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl,
+                              memory, sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger,
+                              score, score_total, placements, placements_total, cmd, params, scratch_i, scratch_f,
+                              mem, rem, width, height, buf, rewards, k_slots, mates, mates_ok, vx, vy, ve, va,
+                              before[g0 - b0:g1 - b0], gain):
+                stops[g] = t
+                break
+        t_end = max(t_end, stops[g])
+    for g in range(stops.shape[0]):
+        g0 = b0 + g * group
+        g1 = min(b1, g0 + group)
+        for t in range(stops[g], t_end):
+            _smdp_turn(g0, g1, t, True, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory,
+                       sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
+                       score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width,
+                       height, buf, rewards, k_slots, mates, mates_ok, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain)
+    t1 = t_end
     # the paper's observations (observe.observe_kernel) of the robots in paper_mask; the others: target -1,
     # state 0, features 0
     for b in range(b0, b1):

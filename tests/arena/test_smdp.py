@@ -5,6 +5,7 @@ import pytest
 
 from confront.arena.scenarios import get_scenario
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv, resolve_drivers
+from confront.arena.tank import TankSpace
 
 
 def _duel(turns: int = 40, opponents: str = "SittingDuck") -> TeamBattleEnv:
@@ -160,3 +161,39 @@ def test_compiled_controller_matches_control_module() -> None:
     assert (ref[..., 4] > 0).any()  # some tanks fire
     assert stale > 0  # some tanks aim at a stale scan, not at the true position
     assert K.X == 0  # the kernel reads the packed arrays by these positions
+
+
+@pytest.mark.parametrize("scenario, opponents, config", [
+    ("4v4", "SpinBot", SMDPConfig()),
+    ("4v4", "td", SMDPConfig(reward="score", tank=TankSpace())),
+    ("1v1", "Walls", SMDPConfig(turns_per_step=40)),
+])
+def test_results_do_not_depend_on_the_battle_group(scenario: str, opponents: str, config: SMDPConfig) -> None:
+    # the kernel steps battles in groups; a group whose battles all end early is given the turns it missed (bots,
+    # scan memory, team messages, rewards), so any group size gives the bits of stepping all battles together
+    envs = []
+    for group in (1, 5, 24):
+        env = TeamBattleEnv(scenario, 24, seed=3, opponents=opponents, config=config)
+        env.battle_group = group
+        env.reset()
+        envs.append(env)
+    rng = np.random.default_rng(0)
+    ended = 0
+    for _ in range(60):
+        actions = rng.integers(0, envs[0].n_actions, size=(24, envs[0].n_robots))
+        results = [env.step(actions) for env in envs]
+        for res in results[1:]:
+            for name in ("discrete", "features", "target", "rewards", "terminated", "round_done", "active"):
+                np.testing.assert_array_equal(getattr(res, name), getattr(results[0], name), err_msg=name)
+        np.testing.assert_array_equal(envs[1]._memory, envs[0]._memory)
+        ended += int(results[0].round_done.sum())
+    assert ended >= 1  # rounds ended mid-step while other battles played on: the groups of 1 and 5 caught up
+
+
+def test_battle_group_must_be_a_positive_integer() -> None:
+    env = TeamBattleEnv("1v1", 2, seed=0)
+    for bad in (0, -3, 2.5, True):
+        with pytest.raises(ValueError, match="battle_group"):
+            env.battle_group = bad
+    env.battle_group = 1
+    assert env.battle_group == 1

@@ -292,17 +292,18 @@ def sweep_hits_box_uv(x0: float, y0: float, ux: float, uy: float, vx: float, vy:
         d3 = vx * y1 - vy * x1
         if d0 < 0.0 and d1 < 0.0 and d2 < 0.0 and d3 < 0.0:
             return False
-    if segment_intersects_rect(0.0, 0.0, r * ux, r * uy, x0, y0, w, w):
-        return True
     if not turned:
-        return False
-    if segment_intersects_rect(0.0, 0.0, r * vx, r * vy, x0, y0, w, w):
-        return True
+        return segment_intersects_rect(0.0, 0.0, r * ux, r * uy, x0, y0, w, w)
+    # the tests are pure, so their order cannot change the answer: the cheap corner tests first
     for k in range(4):
         px = x1 if (k & 1) else x0
         py = y1 if (k & 2) else y0
         if _in_wedge(px, py, ux, uy, vx, vy, r):
             return True
+    if segment_intersects_rect(0.0, 0.0, r * ux, r * uy, x0, y0, w, w):
+        return True
+    if segment_intersects_rect(0.0, 0.0, r * vx, r * vy, x0, y0, w, w):
+        return True
     # the arc bulging into a side: the box point nearest each cardinal extreme of the circle
     for k in range(4):
         qx = min(max(r * ((k == 1) - (k == 3)), x0), x1)

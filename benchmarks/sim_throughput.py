@@ -13,7 +13,8 @@ throughput against batch size at 1 and 2 threads.
 Workloads (``--workload``): ``bots`` (default) plays the same sample robots as the engine column
 (confront.engine.bench's teams: ours SpinBot, Walls, Tracker, RamFire; them Walls, Tracker, Crazy,
 Fire, SpinBot, cycled) with the compiled scripted bots, their decisions included in the time
-(``ScriptedBots.play``: decisions, turn and restart of finished rounds in compiled code, 16 turns a call);
+(``ScriptedBots.play``: decisions, turn and restart of finished rounds in compiled code, 16 turns a call, or
+``--turns-per-call``);
 ``random`` drives every robot with a random AdvancedRobot command stream (new commands every 16
 turns, fire power 0.5-3 every turn: many more bullets than real battles). Finished rounds restart at
 once inside the timed loop. Robot-turns count the robots alive in each turn, as the engine figures
@@ -63,8 +64,9 @@ def command_pool(b: int, r: int, n: int, rng: np.random.Generator) -> np.ndarray
 
 
 def sim_throughput(scenario: str, batch: int, seconds: float, order: str, threads: int | None,
-                   workload: str = "bots") -> dict:
-    """Battle-turns and alive-robot-turns per second for a batch of battles (best of 3 timings)."""
+                   workload: str = "bots", per_call: int = 16) -> dict:
+    """Battle-turns and alive-robot-turns per second for a batch of battles (best of 3 timings); the bots play
+    ``per_call`` turns a call."""
     arena = Arena(scenario, batch, seed=1, order=order, threads=threads)
     rng = np.random.default_rng(0)
     pool = command_pool(batch, arena.n_robots, 8, rng)
@@ -81,9 +83,11 @@ def sim_throughput(scenario: str, batch: int, seconds: float, order: str, thread
         t0 = time.perf_counter()
         i = 0
         while True:
-            if bots is not None:  # 16 x (bots' decisions, one turn, count the alive, restart finished rounds)
-                robot_turns += bots.play(16)
+            if bots is not None:  # per_call x (bots' decisions, one turn, count the alive, restart finished rounds)
+                robot_turns += bots.play(per_call)
+                turns += per_call * batch
             else:
+                turns += 16 * batch
                 for k in range(16):
                     arena.step(pool[i % 8] if k == 0 else keep)
                     robot_turns += int(arena.state.alive.sum())
@@ -91,7 +95,6 @@ def sim_throughput(scenario: str, batch: int, seconds: float, order: str, thread
                     if done.any():
                         arena.reset(done)
             i += 1
-            turns += 16 * batch
             if time.perf_counter() - t0 >= seconds / 3:
                 break
         dt = time.perf_counter() - t0
@@ -218,6 +221,8 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=None, help="worker threads (default: CPUs available)")
     ap.add_argument("--scenarios", default=",".join(SCENARIOS))
     ap.add_argument("--workload", default="bots", choices=["bots", "random"])
+    ap.add_argument("--turns-per-call", type=int, default=16,
+                    help="turns of each ScriptedBots.play call (the bots workload); each call's first turn is slower")
     ap.add_argument("--no-engine", action="store_true", help="skip the real engine")
     ap.add_argument("--team-batches", default="64,256", help="batches of the team-env rows ('' for none)")
     ap.add_argument("--plot", default=None, metavar="PNG", help="write the scaling figure (and print its rows)")
@@ -234,14 +239,16 @@ def main() -> None:
     rows: list[dict] = []
     for sc in args.scenarios.split(","):
         for b in BATCHES:
-            rows.append(sim_throughput(sc, b, args.seconds, args.order, args.threads, args.workload))
+            rows.append(sim_throughput(sc, b, args.seconds, args.order, args.threads, args.workload,
+                                       args.turns_per_call))
         rows.append(raw_step(sc, args.seconds, args.order))
         if not args.no_engine:
             rows.extend(engine_rows(sc))
     for b in [int(v) for v in args.team_batches.split(",") if v]:
         rows.append(team_env("4v4", b, args.seconds, args.threads))
     eng = {r["scenario"]: r["robot_turns_per_s"] for r in rows if r["engine"] == "robocode"}
-    print(f"order={args.order}, threads={args.threads or 'all CPUs'}, load average {os.getloadavg()[0]:.1f}")
+    print(f"order={args.order}, threads={args.threads or 'all CPUs'}, {args.turns_per_call} turns a play() call, "
+          f"load average {os.getloadavg()[0]:.1f}")
     print(f"{'scenario':<8} {'batch':>6} {'engine':<13} {'turns/s':>14} {'robot-turns/s':>15} {'x engine':>9}"
           f" {'decisions/s':>13}")
     for r in rows:

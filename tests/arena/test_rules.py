@@ -105,6 +105,50 @@ def test_radar_sweep():
     assert R.sweep_hits_box(0, 0, 0.7, 0.2, 800, 800)
 
 
+def _pie_meets_box(x: float, y: float, start: float, extent: float, cx: float, cy: float, half: float) -> bool:
+    """Geometric reference for the radar pie (radius 1200, headings clockwise from north) against the square of
+    half-side ``half`` centred on (cx, cy), by dense sampling: a box edge point in the pie, or a point of the
+    pie's boundary (its two radii and its arc, or the start line alone for a zero sweep) in the box."""
+    r = R.RADAR_SCAN_RADIUS
+    t = np.linspace(0.0, 1.0, 801)
+    s = 2 * half * t - half
+    ex = np.concatenate([cx + s, cx + s, np.full_like(s, cx - half), np.full_like(s, cx + half)]) - x
+    ey = np.concatenate([np.full_like(s, cy - half), np.full_like(s, cy + half), cy + s, cy + s]) - y
+    lo, hi = (start, start + extent) if extent >= 0 else (start + extent, start)
+    ang = np.arctan2(ex, ey)  # heading of each edge point
+    off = np.mod(ang - lo, 2 * np.pi)
+    inside = (ex * ex + ey * ey <= r * r) & (off <= hi - lo)
+    if extent != 0.0 and inside.any():
+        return True
+    lines = [start] if extent == 0.0 else [start, start + extent]
+    pts = [(x + r * t * math.sin(a), y + r * t * math.cos(a)) for a in lines]
+    if extent != 0.0:
+        arc = lo + (hi - lo) * t
+        pts.append((x + r * np.sin(arc), y + r * np.cos(arc)))
+    return any(bool(np.any((np.abs(px - cx) <= half) & (np.abs(py - cy) <= half))) for px, py in pts)
+
+
+def test_radar_sweep_against_a_sampled_reference():
+    # random robots, sweeps of both signs up to pi, narrow and zero sweeps; cases within half a pixel of the boundary
+    # (the sampled reference answers differently for a box 0.5 px smaller and larger) are left out
+    rng = np.random.default_rng(7)
+    checked = hits = 0
+    for _ in range(1500):
+        x, y = rng.uniform(0, 800, 2)
+        cx, cy = rng.uniform(0, 800, 2)
+        start = rng.uniform(-2 * np.pi, 2 * np.pi)
+        kind = rng.random()  # a zero sweep, a narrow one (a box far off can be wider than it), or any
+        extent = 0.0 if kind < 0.15 else rng.uniform(-0.05, 0.05) if kind < 0.5 else rng.uniform(-np.pi, np.pi)
+        small = _pie_meets_box(x, y, start, extent, cx, cy, R.ROBOT_HALF - 0.5)
+        large = _pie_meets_box(x, y, start, extent, cx, cy, R.ROBOT_HALF + 0.5)
+        if small != large:
+            continue
+        assert R.sweep_hits_box(x, y, start, extent, cx, cy) == small, (x, y, start, extent, cx, cy)
+        checked += 1
+        hits += small
+    assert checked > 1400 and 100 < hits < checked - 100
+
+
 def test_java_random_matches_java():
     s = R.java_seed(42)
     s, d = R.java_next_double(s)

@@ -121,7 +121,8 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     ``paper_mask`` (R,), the others' target -1, state and features 0). Returns the turn index
     where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
     run in parallel threads. Each robot picks its target and aims from its own picture
-    (observe.perceive_row); after each turn the robots' scans go into ``memory``."""
+    (observe.perceive_row); after each turn the robots' scans go into ``memory``. The battles are stepped in
+    groups of ``group`` (TeamBattleEnv.battle_group); the results do not depend on it."""
     n = rf.shape[2]
     return _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory,
                       sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,

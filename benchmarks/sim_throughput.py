@@ -2,7 +2,9 @@
 
 Usage: ``python benchmarks/sim_throughput.py [--json] [--seconds S] [--order engine|shuffle|fixed] [--plot PNG]``.
 Prints a table; with ``--json`` the last line is one JSON list of records with keys scenario, batch,
-engine, turns_per_s, robot_turns_per_s (team-env rows add decisions_per_s, threads).
+engine, turns_per_s, robot_turns_per_s (simulator rows add robot_turns_per_cpu_s; team-env rows add
+decisions_per_s, decisions_per_cpu_s, threads). The "per CPU-s" column divides by the process's CPU time (all
+its threads): on a machine shared with other jobs it moves less than the wall-clock rates.
 
 ``team-env`` rows: :class:`TeamBattleEnv` with learner actions, the learner-facing path: 4v4 against SpinBot,
 T = 10, uniformly random actions of the paper's 4 moves for the 4 learning tanks, ``batch`` battles;
@@ -76,11 +78,11 @@ def sim_throughput(scenario: str, batch: int, seconds: float, order: str, thread
     arena.step(pool[0])  # compile / warm up
     if bots is not None:
         bots.play(1)
-    best = (0.0, 0.0)
+    best = (0.0, 0.0, 0.0)
     for _ in range(3):
         turns = 0
         robot_turns = 0
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         i = 0
         while True:
             if bots is not None:  # per_call x (bots' decisions, one turn, count the alive, restart finished rounds)
@@ -97,11 +99,11 @@ def sim_throughput(scenario: str, batch: int, seconds: float, order: str, thread
             i += 1
             if time.perf_counter() - t0 >= seconds / 3:
                 break
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         if robot_turns / dt > best[1]:
-            best = (turns / dt, robot_turns / dt)
+            best = (turns / dt, robot_turns / dt, robot_turns / cpu)
     return {"scenario": scenario, "batch": batch, "engine": f"sim-{workload}", "turns_per_s": best[0],
-            "robot_turns_per_s": best[1]}
+            "robot_turns_per_s": best[1], "robot_turns_per_cpu_s": best[2]}
 
 
 def raw_step(scenario: str, seconds: float, order: str) -> dict:
@@ -113,7 +115,7 @@ def raw_step(scenario: str, seconds: float, order: str) -> dict:
     arena.step(cmd)
     n = 0
     alive = 0
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     while time.perf_counter() - t0 < seconds:
         for _ in range(1000):
             arena.step(cmd)
@@ -121,9 +123,9 @@ def raw_step(scenario: str, seconds: float, order: str) -> dict:
         n += 1000
         if arena.state.done[0]:
             arena.reset()
-    dt = time.perf_counter() - t0
+    dt, cpu = time.perf_counter() - t0, time.process_time() - c0
     return {"scenario": scenario, "batch": 1, "engine": "sim-raw-step", "turns_per_s": n / dt,
-            "robot_turns_per_s": alive / dt}
+            "robot_turns_per_s": alive / dt, "robot_turns_per_cpu_s": alive / cpu}
 
 
 def team_env(scenario: str, batch: int, seconds: float, threads: int | None = None, opponents: str = "SpinBot",
@@ -144,10 +146,10 @@ def team_env(scenario: str, batch: int, seconds: float, threads: int | None = No
     learners = int(env.learner.sum())
     acts = np.random.default_rng(0).integers(0, env.n_actions, size=(16, batch, env.n_robots))
     env.step(acts[0])
-    best = (0.0, 0.0, 0.0)
+    best = (0.0, 0.0, 0.0, 0.0)
     for _ in range(3):
         steps, robot_turns, i = 0, 0.0, 0
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         while True:
             alive = env.arena.state.alive.sum()
             env.step(acts[i % 16])
@@ -156,12 +158,12 @@ def team_env(scenario: str, batch: int, seconds: float, threads: int | None = No
             i += 1
             if time.perf_counter() - t0 >= seconds / 3:
                 break
-        dt = time.perf_counter() - t0
+        dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         if steps / dt > best[0]:
-            best = (steps / dt, robot_turns / dt, steps * batch * turns / dt)
+            best = (steps / dt, robot_turns / dt, steps * batch * turns / dt, steps / cpu)
     return {"scenario": scenario, "batch": batch, "engine": "team-env", "threads": len(env._ranges),
             "decisions_per_s": best[0] * batch * learners, "robot_turns_per_s": float(best[1]),
-            "turns_per_s": best[2]}
+            "turns_per_s": best[2], "decisions_per_cpu_s": best[3] * batch * learners}
 
 
 def scaling_plot(path: str, seconds: float) -> list[dict]:
@@ -250,12 +252,15 @@ def main() -> None:
     print(f"order={args.order}, threads={args.threads or 'all CPUs'}, {args.turns_per_call} turns a play() call, "
           f"load average {os.getloadavg()[0]:.1f}")
     print(f"{'scenario':<8} {'batch':>6} {'engine':<13} {'turns/s':>14} {'robot-turns/s':>15} {'x engine':>9}"
-          f" {'decisions/s':>13}")
+          f" {'per CPU-s':>13} {'decisions/s':>13}")
     for r in rows:
         ratio = r["robot_turns_per_s"] / eng[r["scenario"]] if r["scenario"] in eng else float("nan")
         dec = f"{r['decisions_per_s']:>13,.0f}" if "decisions_per_s" in r else ""
+        # robot-turns (decisions for the team env) per second of the process's CPU time: steadier on a busy machine
+        cpu = r.get("decisions_per_cpu_s", r.get("robot_turns_per_cpu_s"))
+        per_cpu = f"{cpu:>13,.0f}" if cpu is not None else f"{'':>13}"
         print(f"{r['scenario']:<8} {r['batch']:>6} {r['engine']:<13} {r['turns_per_s']:>14,.0f} "
-              f"{r['robot_turns_per_s']:>15,.0f} {ratio:>9,.0f} {dec}")
+              f"{r['robot_turns_per_s']:>15,.0f} {ratio:>9,.0f} {per_cpu} {dec}")
     if args.json:
         print(json.dumps(rows))
 

@@ -229,6 +229,8 @@ def main() -> None:
     ap.add_argument("--team-batches", default="64,256", help="batches of the team-env rows ('' for none)")
     ap.add_argument("--plot", default=None, metavar="PNG", help="write the scaling figure (and print its rows)")
     args = ap.parse_args()
+    if args.turns_per_call < 1:
+        ap.error(f"--turns-per-call must be >= 1, got {args.turns_per_call}")
     if args.plot:
         rows = scaling_plot(args.plot, args.seconds)
         for r in rows:

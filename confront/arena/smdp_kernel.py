@@ -264,7 +264,6 @@ def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, powe
                        sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
                        score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width,
                        height, buf, rewards, k_slots, mates, mates_ok, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain)
-    t1 = t_end
     # the paper's observations (observe.observe_kernel) of the robots in paper_mask; the others: target -1,
     # state 0, features 0
     for b in range(b0, b1):
@@ -294,7 +293,7 @@ def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, powe
                 else:
                     view[b, i, :] = 0.0
                     slots[b, i, :] = -1
-    return t1
+    return t_end
 
 
 install(globals())

@@ -41,7 +41,7 @@ def arm(rounds: int, seed: int) -> list[dict]:
 
 
 def migration(seeds: int) -> list[dict]:
-    from confront.learning.migration import run_migration
+    from confront.experiments.migration import run_migration
 
     run_migration(seeds=2, episodes=2)  # compile (or load) the kernel first
     t0, c0 = time.perf_counter(), time.process_time()

@@ -270,8 +270,8 @@ def _head_values(folders: Sequence[Path], head: int) -> np.ndarray:
 
 
 def migration_outcome(seeds: int, out: Path, episodes: int | None) -> Outcome:
-    """§6.2: delegated to confront.learning.migration (no arena needed); all seeds side by side."""
-    from confront.learning import migration as mig
+    """§6.2: delegated to confront.experiments.migration (no arena needed); all seeds side by side."""
+    from confront.experiments import migration as mig
 
     o = Outcome("migration", seeds=seeds)
     start = time.time()

@@ -1,9 +1,9 @@
 import gymnasium
 import numpy as np
 
+from confront.experiments.migration import BinaryTreeMigration
 from confront.learning import make_learner
 from confront.learning.envloop import run_episodes
-from confront.learning.migration import BinaryTreeMigration
 
 
 def test_td_learner_solves_frozen_lake():

@@ -1,10 +1,7 @@
 import numpy as np
 import pytest
 
-from confront.learning import make_learner
-from confront.learning.base import Transition
-from confront.learning.exploration import policy_probs
-from confront.learning.migration import (
+from confront.experiments.migration import (
     METHODS,
     BinaryTreeMigration,
     MigrationResult,
@@ -18,6 +15,9 @@ from confront.learning.migration import (
     run_migration,
     seed_draws,
 )
+from confront.learning import make_learner
+from confront.learning.base import Transition
+from confront.learning.exploration import policy_probs
 
 TABLE1 = {"alpha": 0.3, "gamma": 0.9, "exploit": 0.9, "eta": 0.9, "t_max": 0.1, "t_min": 0.01, "exploit_decay": 0.99}
 

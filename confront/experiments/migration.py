@@ -25,6 +25,7 @@ import gymnasium
 import numpy as np
 from numba import njit
 
+from confront.experiments.stats import median_ci, sign_test
 from confront.learning.base import check_int, check_range
 from confront.learning.factory import make_learner
 from confront.learning.tabular import TabularParams
@@ -317,8 +318,6 @@ def _pct(x: float) -> str:
 def paired_rows(result: MigrationResult) -> list[dict[str, Any]]:
     """Per pair of methods and Q: a sign test of "a converges earlier than b" on the same seeds, the median
     paired difference b - a (episodes) with its 95% interval, and the detectable share at power 0.8."""
-    from confront.experiments.stats import median_ci, sign_test
-
     out = []
     for a, b, alternative in PAIRS:
         if a not in result.convergence or b not in result.convergence:
@@ -351,8 +350,6 @@ def paired_table(result: MigrationResult) -> str:
 
 
 def _level_claim(result: MigrationResult) -> dict[str, Any]:
-    from confront.experiments.stats import median_ci, sign_test
-
     c = result.censored("ssaq")
     cells, effects, ps, mdes, inside = [], [], [], [], []
     for j, node in enumerate(TRACKED):
@@ -379,8 +376,6 @@ def _level_claim(result: MigrationResult) -> dict[str, Any]:
 
 
 def _order_claim(result: MigrationResult) -> dict[str, Any]:
-    from confront.experiments.stats import median_ci, sign_test
-
     c = result.censored("ssaq")
     gaps = [(3, 7), (7, 15)]
     idx = {k: j for j, k in enumerate(TRACKED)}
@@ -517,7 +512,7 @@ def format_summary(result: MigrationResult) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m confront.learning.migration``: run the comparison, print the tables, draw Figure 9."""
+    """``python -m confront.experiments.migration``: run the comparison, print the tables, draw Figure 9."""
     import argparse
 
     ap = argparse.ArgumentParser(description=main.__doc__)

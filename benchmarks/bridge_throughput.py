@@ -26,7 +26,8 @@ reported on its own. "excl. policy" also leaves out the time spent inside the Py
 Java policy would cost instead is in the ``java`` row). Goal of issue 5: cost <= 25%.
 
 Usage: python benchmarks/bridge_throughput.py [--rounds 10] [--repeats 3] [--cpu-ms 100] [--lead 5]
-       [--max-lag 1] [--acting-lag 8] [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--json FILE]
+       [--max-lag 1] [--acting-lag 8] [--check-rounds 100] [--battles 1v1,4v4] [--modes sample,java,...] [--one-cpu]
+       [--json FILE]
 """
 
 from __future__ import annotations
@@ -198,16 +199,19 @@ def main() -> None:
     ap.add_argument("--modes", default=",".join(MODES))
     ap.add_argument("--check-rounds", type=int, default=0, help="also a bridged 1v1 of this many rounds")
     ap.add_argument("--json", type=Path, help="write the records here")
+    ap.add_argument("--one-cpu", action="store_true",
+                    help="every engine process (the references too) on one CPU (EngineOptions.one_cpu)")
     args = ap.parse_args()
     modes = [m for m in MODES if m in args.modes.split(",")]
     sizes = {"1v1": 1, "4v4": 4}
     battles = [b for b in args.battles.split(",") if b]
     if unknown := [b for b in battles if b not in sizes]:
         raise ValueError(f"unknown battle {unknown[0]!r}; choose from {sorted(sizes)}")
-    opts = EngineOptions(seed=args.seed, cpu_constant_ms=args.cpu_ms)
+    opts = EngineOptions(seed=args.seed, cpu_constant_ms=args.cpu_ms, one_cpu=args.one_cpu)
     policy = ExportedPolicy("qtable", q=np.random.default_rng(args.seed).normal(size=(320, 4)),
                             step_turns=args.every)
     print(f"rounds={args.rounds} repeats={args.repeats} cpu_constant_ms={args.cpu_ms} seed={args.seed} "
+          f"one_cpu={args.one_cpu} "
           f"T={args.every} lead={args.lead} load average at start {os.getloadavg()[0]:.1f}", flush=True)
     records = []
     with tempfile.TemporaryDirectory(prefix="confront-bench-") as tmp:

@@ -10,7 +10,8 @@ Two runs, alternated over ``--repeats`` (the order flips each repetition: train 
   ``train.checkpoint_every`` rounds (engine seeds ``train.seed + k``), the checkpoints, tables, model and plots
   of a run folder;
 - ``exported``: the last training run's table as the exported PolicyBot (``exported_policy``, ``export_robot``)
-  in the same battles (``exported_battle``: the same scenario, opponent, rounds, engine seeds and CPU constant as
+  in the same battles (``exported_battle``: the same scenario, opponent, rounds, engine seeds, CPU constant and
+  one-CPU setting (``EngineOptions.one_cpu``, on in engine training; ``--stock-engine``: off on both sides) as
   the training's battles, taken from the battles the training played), JVM start included; the export itself
   (writing and compiling the robot once per repetition) is timed apart and left out.
 
@@ -30,7 +31,7 @@ numba kernels, the Java build check), so every repetition measures the same thin
 process pays those on top.
 
 Usage: python benchmarks/engine_training.py [--repeats 3] [--rounds 100] [--config demo] [--set KEY=VALUE ...]
-       [--cpu-ms 100] [--warmup-rounds 2] [--keep DIR] [--json FILE]
+       [--cpu-ms 100] [--warmup-rounds 2] [--keep DIR] [--json FILE] [--stock-engine]
 Prints a table, the medians, and a last line of JSON (median ratio, load average).
 """
 
@@ -46,6 +47,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -69,17 +71,20 @@ def _cpu() -> tuple[float, float]:
 
 
 @contextlib.contextmanager
-def _battles_of_training() -> Iterator[list[dict[str, Any]]]:
+def _battles_of_training(one_cpu: bool | None = None) -> Iterator[list[dict[str, Any]]]:
     """Time every battle the engine trainer plays (``run_bridged_battle`` as ``train_engine`` calls it) and keep
-    what it needs to be replayed by the exported robot: rounds, engine seed, CPU constant."""
+    what it needs to be replayed by the exported robot: rounds, engine seed, CPU constant, one-CPU setting
+    (``one_cpu``: None keeps the trainer's, else forced on both sides)."""
     played: list[dict[str, Any]] = []
     original = train_engine.run_bridged_battle
 
     def timed(spec, policy, options=None, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        if one_cpu is not None:
+            options = replace(options, one_cpu=one_cpu)
         t0 = time.perf_counter()
         res = original(spec, policy, options, *args, **kwargs)
         played.append({"wall_s": time.perf_counter() - t0, "rounds": spec.rounds, "seed": options.seed,
-                       "cpu_constant_ms": options.cpu_constant_ms, "bridged": res})
+                       "cpu_constant_ms": options.cpu_constant_ms, "one_cpu": options.one_cpu, "bridged": res})
         return res
 
     train_engine.run_bridged_battle = timed
@@ -117,9 +122,10 @@ def _record(mode: str, rep: int, wall: float, cpu0: tuple[float, float], battles
     return rec
 
 
-def train_once(cfg: ExperimentConfig, out: Path, rep: int, cpu_ms: float) -> tuple[dict[str, Any], list[dict]]:
+def train_once(cfg: ExperimentConfig, out: Path, rep: int, cpu_ms: float,
+               one_cpu: bool | None = None) -> tuple[dict[str, Any], list[dict]]:
     """One training run (``train_run(engine="robocode")``) into ``out``: its record and its battles."""
-    with _battles_of_training() as played:
+    with _battles_of_training(one_cpu) as played:
         cpu0 = _cpu()
         t0 = time.perf_counter()
         summary = train_run(cfg, out, progress=False, engine="robocode", cpu_constant_ms=cpu_ms)
@@ -143,7 +149,7 @@ def exported_once(cfg: ExperimentConfig, run: Path, played: list[dict[str, Any]]
     for b in played:
         t1 = time.perf_counter()
         res = exported_battle(robot, cfg.arena.scenario, OPPONENT, b["rounds"],
-                              EngineOptions(seed=b["seed"], cpu_constant_ms=b["cpu_constant_ms"]))
+                              EngineOptions(seed=b["seed"], cpu_constant_ms=b["cpu_constant_ms"], one_cpu=b["one_cpu"]))
         battles.append({"wall_s": time.perf_counter() - t1, "rounds": b["rounds"], "run": res})
     wall = time.perf_counter() - t0
     ratio = statistics.mean(r["run"].results.score_ratio(_ours(r["run"])) for r in battles)
@@ -200,11 +206,15 @@ def main() -> None:
     ap.add_argument("--warmup-rounds", type=int, default=2, help="untimed training and export first (0: none)")
     ap.add_argument("--keep", type=Path, default=None, help="keep the run folders here (default: a temp dir)")
     ap.add_argument("--json", type=Path, default=None, help="write every record here")
+    ap.add_argument("--stock-engine", action="store_true",
+                    help="engine processes unpinned (EngineOptions.one_cpu off) on both sides, as before")
     args = ap.parse_args()
+    one_cpu = False if args.stock_engine else None
     overrides = [*ISSUE_SETTINGS, f"train.rounds={args.rounds}", *args.set]
     cfg = load_experiment(args.config, overrides)
     load0 = os.getloadavg()
     print(f"{args.rounds} rounds, {' '.join(overrides)}, CPU constant {args.cpu_ms:g} ms, "
+          f"{'engine unpinned' if args.stock_engine else 'engine on one CPU'}, "
           f"{args.repeats} repetitions; load average {load0[0]:.1f} {load0[1]:.1f} {load0[2]:.1f}", flush=True)
     records: list[dict[str, Any]] = []
     with tempfile.TemporaryDirectory(prefix="confront-bench-") as tmpdir:
@@ -215,7 +225,7 @@ def main() -> None:
             t0 = time.perf_counter()
             n = args.warmup_rounds
             warm = load_experiment(args.config, [*overrides, f"train.rounds={n}", f"train.session_rounds={n}"])
-            _, played = train_once(warm, tmp / "warmup", -1, args.cpu_ms)
+            _, played = train_once(warm, tmp / "warmup", -1, args.cpu_ms, one_cpu)
             exported_once(warm, tmp / "warmup", played, -1, tmp)
             print(f"warm-up ({args.warmup_rounds} rounds each, not timed below): {time.perf_counter() - t0:.1f} s",
                   flush=True)
@@ -226,7 +236,7 @@ def main() -> None:
             for mode in order:
                 if mode == "train":
                     out = base / f"train-{rep}"
-                    rec, played = train_once(cfg, out, rep, args.cpu_ms)
+                    rec, played = train_once(cfg, out, rep, args.cpu_ms, one_cpu)
                     last = (out, played)
                 else:
                     assert last is not None  # the first repetition trains first

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from confront.engine.affinity import ONE_CPU_JVM_FLAGS, claimed_cpu
 from confront.engine.battle import BattleSpec
 from confront.engine.install import JVM_FLAGS, EngineInstall, find_engine
 from confront.engine.java_build import compile_java
@@ -37,6 +38,10 @@ class EngineOptions:
     # process's environment is readable only by its user); kept out of repr
     env: tuple[tuple[str, str], ...] = field(default=(), repr=False)
     round_start_fix: bool = True  # RoundStartAgent: no lost wake-up wait at round start (docs/engine.md)
+    # run the engine process on one claimed CPU with the C1 compiler only (confront.engine.affinity): 1.2-2.5x
+    # faster on the project's machine, but the engine's thread races may then go the other way (docs/engine.md,
+    # "One CPU per engine"), so it is for training in the engine, not for comparisons with the simulator
+    one_cpu: bool = False
 
     def __post_init__(self) -> None:
         if self.seed is not None and not -(2**63) <= self.seed < 2**63:
@@ -66,11 +71,16 @@ class EngineRun:
     trace: Path | None = None
     stopped_at_turn: int = -1
     summary: dict[str, Any] = field(default_factory=dict, repr=False)
+    cpu: int | None = None  # the one CPU the engine process ran on (EngineOptions.one_cpu), None: unpinned
 
 
-def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: EngineOptions) -> list[str]:
-    """The JVM command line for the runner (flags from robocode-facts.md section 0)."""
+def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: EngineOptions,
+                 one_cpu: bool = False) -> list[str]:
+    """The JVM command line for the runner (flags from robocode-facts.md section 0; ``one_cpu``: the process
+    will run on one CPU, so it compiles with C1 only)."""
     cmd = [install.java, f"-Xmx{opts.max_heap_mb}M", f"-DWORKINGDIRECTORY={workdir}", *JVM_FLAGS]
+    if one_cpu:
+        cmd += list(ONE_CPU_JVM_FLAGS)
     if opts.seed is not None:
         cmd.append(f"-DRANDOMSEED={opts.seed}")  # repeatable random order and start positions
     if opts.nosecurity:
@@ -106,14 +116,20 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child between 
 
 
 def run_process(cmd: Sequence[str], timeout_s: float, cwd: Path, log: Path,
-                env: Mapping[str, str] | None = None) -> int:
-    """Run ``cmd`` in its own process group (``env``: variables added to this process's environment); kill the
-    whole group on timeout, error or Ctrl-C."""
+                env: Mapping[str, str] | None = None, cpu: int | None = None) -> int:
+    """Run ``cmd`` in its own process group (``env``: variables added to this process's environment; ``cpu``:
+    the only CPU it may run on); kill the whole group on timeout, error or Ctrl-C."""
     full_env = {**os.environ, **env} if env else None
+
+    def child() -> None:  # pragma: no cover - runs in the child between fork and exec
+        _die_with_parent()
+        if cpu is not None:
+            os.sched_setaffinity(0, {cpu})
+
     with open(log, "wb") as out:
         proc = subprocess.Popen(list(cmd), cwd=cwd, env=full_env, stdout=out, stderr=subprocess.STDOUT,
                                 stdin=subprocess.DEVNULL, start_new_session=True,
-                                preexec_fn=_die_with_parent if sys.platform == "linux" else None)
+                                preexec_fn=child if sys.platform == "linux" else None)
         try:
             return proc.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
@@ -180,8 +196,9 @@ def run_battle(
         if trace is not None:
             args.append(str(Path(trace).resolve()))
         log = run_dir / "engine.log"
-        code = run_process(java_command(install, classes, wd, opts) + args, opts.timeout_s, run_dir, log,
-                           env=dict(opts.env))
+        with claimed_cpu(opts.one_cpu) as cpu:
+            cmd = java_command(install, classes, wd, opts, one_cpu=cpu is not None) + args
+            code = run_process(cmd, opts.timeout_s, run_dir, log, env=dict(opts.env), cpu=cpu)
         if not summary_file.is_file():
             tail = log.read_text(errors="replace")[-2000:]
             raise RuntimeError(f"engine run failed (exit {code}) without a summary:\n{tail}")
@@ -196,7 +213,7 @@ def run_battle(
         elapsed_s=summary["elapsed_s"], setup_s=summary["setup_s"],
         round_turns=tuple(summary["round_turns"]), skipped_turns=dict(summary["skipped_turns"]),
         errors=tuple(summary["errors"]), trace=Path(trace) if trace is not None else None,
-        stopped_at_turn=summary["stopped_at_turn"], summary=summary,
+        stopped_at_turn=summary["stopped_at_turn"], summary=summary, cpu=cpu,
     )
 
 

@@ -275,7 +275,7 @@ class EngineTankTrainer:
             props = (f"-Dconfront.tank.model={folder / 'policy.txt'}", f"-Dconfront.tank.log={folder / 'log'}",
                      f"-Dconfront.scores={folder / 'scores.txt'}")
             opts = EngineOptions(seed=self.cfg.train.seed + self.battles, cpu_constant_ms=self.cpu_constant_ms,
-                                 nosecurity=True, extra_jvm_args=props)
+                                 nosecurity=True, extra_jvm_args=props, one_cpu=True)
             opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * rounds)
             opp = entry.partition(":")[2]
             extra = [self.jar] + ([self.opponents[opp]] if opp in self.opponents else [])

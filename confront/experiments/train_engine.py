@@ -194,7 +194,8 @@ class EngineTrainer:
         done = self.rounds_done
         rounds = min(self.cfg.train.checkpoint_every, limit - done)
         # a training battle gets time: 10 s per round on top of the default limit
-        opts = EngineOptions(seed=self.cfg.train.seed + self.battles, cpu_constant_ms=self.cpu_constant_ms)
+        opts = EngineOptions(seed=self.cfg.train.seed + self.battles, cpu_constant_ms=self.cpu_constant_ms,
+                             one_cpu=True)
         opts = replace(opts, timeout_s=opts.timeout_s + 10.0 * rounds)
         res: BridgedRun = run_bridged_battle(_battle(self.cfg, self.opponent, rounds),
                                              _Progress(self.policy, tick, done), opts, extra_robots=self.extra,

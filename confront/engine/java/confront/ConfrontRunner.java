@@ -37,7 +37,8 @@ import robocode.control.snapshot.ITurnSnapshot;
  * Runs one battle file headless on Robocode's control API.
  *
  * Writes the engine's own results table (same writer as the command line's -results), a JSON summary
- * (turn counts, skipped turns, exact score parts per robot and per contestant, timings) and, when asked,
+ * (turn counts, skipped turns, exact score parts per robot and per contestant, timings, the CPUs the JVM may
+ * use) and, when asked,
  * a JSONL trace of every turn. Arguments: WORKDIR BATTLE_FILE RESULTS_FILE SUMMARY_FILE [TRACE_FILE].
  *
  * <p>With the JVM property confront.scores=PATH it also writes each robot's current-round score per turn
@@ -416,6 +417,7 @@ public final class ConfrontRunner extends BattleAdaptor {
                 .append(",\"turns\":").append(turns).append(",\"robot_turns\":").append(robotTurns)
                 .append(",\"elapsed_s\":").append(elapsed)
                 .append(",\"setup_s\":").append(setupNanos / 1e9)
+                .append(",\"cpus\":").append(Runtime.getRuntime().availableProcessors())
                 .append(",\"round_turns\":").append(roundTurns.toString())
                 .append(",\"round_scores\":[").append(roundScores).append(']')
                 .append(",\"skipped_turns\":{");

@@ -8,8 +8,9 @@ Two runs, alternated over ``--repeats`` (the order flips each repetition):
   of TankBots (sampled, logging their decisions) and one PPO update per ``--battle-rounds`` rounds, checkpoints,
   tables, model and plots;
 - ``exported``: the training run's saved policy (sampled) in the same battles (rounds, engine seeds
-  ``train.seed + k``, CPU constant) through ``evaluate_tank_policy``, which exports the jar on every call; one
-  export is timed apart (``export_s``) and ``battles_s`` is the wall time less one export per battle.
+  ``train.seed + k``, CPU constant, the engine on one CPU as in training) through ``evaluate_tank_policy``, which
+  exports the jar on every call; one export is timed apart (``export_s``) and ``battles_s`` is the wall time less
+  one export per battle.
 
 Per run: wall s (the whole ``train_run`` call / the evaluations), the training's time in its battles (writing the
 policy file and the engine process: ``engine_s`` of metrics/updates.csv), in reading the logs and building the
@@ -73,7 +74,7 @@ def exported_once(cfg: ExperimentConfig, run: Path, rep: int, tmp: Path) -> dict
     for k in range(n):
         rounds = min(cfg.train.checkpoint_every, cfg.train.rounds - k * cfg.train.checkpoint_every)
         res, ratio = evaluate_tank_policy(policy, "1v1", OPPONENT, rounds=rounds, seed=cfg.train.seed + k,
-                                          cpu_constant_ms=TANK_CPU_CONSTANT_MS)
+                                          cpu_constant_ms=TANK_CPU_CONSTANT_MS, one_cpu=True)  # as training
         ratios.append(ratio)
     wall = time.perf_counter() - t0
     return {"mode": "exported", "repeat": rep, "wall_s": wall, "battles_s": wall - n * export_s,

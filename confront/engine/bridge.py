@@ -497,6 +497,7 @@ class BridgeServer:
         self._listener.setblocking(False)
         self.port: int = self._listener.getsockname()[1]
         self._stop = threading.Event()
+        self._wake_r, self._wake_w = socket.socketpair()  # stop() wakes the accepting thread's select at once
         self._lock = threading.Lock()
         self._conns: set[socket.socket] = set()
         self._acting: dict[socket.socket, str] = {}  # robots that act themselves: their update streams
@@ -513,6 +514,7 @@ class BridgeServer:
         """Accept robots and read their hellos until :meth:`stop`; each session runs in its own thread."""
         sel = selectors.DefaultSelector()
         sel.register(self._listener, selectors.EVENT_READ)
+        sel.register(self._wake_r, selectors.EVENT_READ)
         pending: dict[socket.socket, _Pending] = {}  # insertion order: oldest first
         try:
             while not self._stop.is_set():
@@ -521,6 +523,8 @@ class BridgeServer:
                 for key, _ in ready:  # hellos first, so a burst of new connections cannot push them out
                     if key.fileobj is self._listener:
                         listening = True
+                    elif key.fileobj is self._wake_r:
+                        continue  # stop() was called: the loop's test ends it
                     else:
                         self._read_hello(key.fileobj, pending, sel)  # type: ignore[arg-type]
                 if listening:
@@ -533,6 +537,7 @@ class BridgeServer:
                 self._drop(sock, pending, sel, None)
             sel.close()
             self._listener.close()
+            self._wake_r.close()
 
     def _accept(self, pending: dict[socket.socket, _Pending], sel: selectors.BaseSelector) -> None:
         for _ in range(16):  # a few per pass, then the pending hellos are read again
@@ -614,8 +619,14 @@ class BridgeServer:
         their robot sent before it closed its end: a robot's last end line may still be unread when the engine
         exits (robots acting themselves do not even wait for their last observations to be read)."""
         self._stop.set()
+        with contextlib.suppress(OSError):
+            self._wake_w.send(b"\0")
+        self._wake_w.close()
         if self._thread is not None:
             self._thread.join(timeout=5)
+        else:  # never started: serve_forever did not run to close these
+            self._wake_r.close()
+            self._listener.close()
         deadline = time.monotonic() + drain_s
         with self._lock:
             sessions = list(self._sessions)

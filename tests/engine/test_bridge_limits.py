@@ -144,3 +144,18 @@ def test_error_messages_are_bounded() -> None:
                 s.makefile().readline()
         assert _wait(lambda: len(server.stats.errors) + server.stats.errors_dropped == bridge.MAX_ERRORS + 20)
     assert len(server.stats.errors) == bridge.MAX_ERRORS and server.stats.errors_dropped == 20
+
+
+def test_stop_ends_the_server_and_closes_its_sockets() -> None:
+    """stop() wakes the accepting thread (no waiting out its select), which closes the listener; a server that was
+    never started closes its sockets too."""
+    server = BridgeServer(Recorder(), token="t0k").start()
+    thread, port = server._thread, server.port
+    assert thread is not None and thread.is_alive()
+    server.stop()
+    assert not thread.is_alive()
+    with pytest.raises(OSError):
+        socket.create_connection(("127.0.0.1", port), timeout=2).close()
+    idle = BridgeServer(Recorder(), token="t0k")
+    idle.stop()
+    assert idle._listener.fileno() == -1 and idle._wake_r.fileno() == -1 and idle._wake_w.fileno() == -1

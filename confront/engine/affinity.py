@@ -54,7 +54,8 @@ def idlest_first(cpus: list[int], sample_s: float = SAMPLE_S) -> list[int]:
 @contextlib.contextmanager
 def claimed_cpu(enabled: bool = True, folder: Path | None = None) -> Iterator[int | None]:
     """Claim one CPU of this process's allowed set for as long as the block runs; None: run unpinned (not
-    enabled, fewer than two CPUs, no way to set affinity, or every CPU claimed by other engine runs)."""
+    enabled, fewer than two CPUs, no way to set affinity, no writable lock folder, or every CPU claimed by other
+    engine runs)."""
     if not enabled or not hasattr(os, "sched_setaffinity"):
         yield None
         return
@@ -63,9 +64,16 @@ def claimed_cpu(enabled: bool = True, folder: Path | None = None) -> Iterator[in
         yield None
         return
     folder = folder if folder is not None else cache_root() / "cpus"
-    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:  # no writable cache: no claims, so no pinning either
+        yield None
+        return
     for cpu in idlest_first(cpus):
-        lock = open(folder / f"cpu{cpu}.lock", "a")  # held open for the claim
+        try:
+            lock = open(folder / f"cpu{cpu}.lock", "a")  # held open for the claim
+        except OSError:
+            continue
         try:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:

@@ -79,3 +79,11 @@ def test_a_battle_held_to_one_cpu(install: EngineInstall) -> None:
         assert held.cpu in allowed and held.summary["cpus"] == 1
     assert held.round_turns == free.round_turns
     assert held.results == free.results
+
+
+@needs_affinity
+def test_no_claim_without_a_writable_lock_folder(three_cpus: None, tmp_path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    with claimed_cpu(folder=blocker / "cpus") as cpu:  # a folder inside a file cannot be made
+        assert cpu is None

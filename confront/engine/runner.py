@@ -41,7 +41,7 @@ class EngineOptions:
     round_start_fix: bool = True  # RoundStartAgent: no lost wake-up wait at round start (docs/engine.md)
     # run the engine process on one claimed CPU with the C1 compiler only (confront.engine.affinity): 1.2-2.5x
     # faster on the project's machine, but the engine's thread races may then go the other way (docs/engine.md,
-    # "One CPU per engine"), so it is for training in the engine, not for comparisons with the simulator
+    # "One CPU per engine process"), so it is for training in the engine, not for comparisons with the simulator
     one_cpu: bool = False
 
     def __post_init__(self) -> None:

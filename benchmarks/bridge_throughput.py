@@ -171,13 +171,12 @@ def report(records: list[dict[str, Any]]) -> None:
         print(f"{battle}: turns java vs acting T per repetition {same} (equal = the same battle)")
 
 
-def check_skipped(rounds: int, every: int, cpu_ms: float, seed: int, policy: ExportedPolicy) -> dict[str, Any]:
+def check_skipped(rounds: int, every: int, opts: EngineOptions, policy: ExportedPolicy) -> dict[str, Any]:
     """A bridged 1v1 evaluation (the twin, a move every T turns, the Java controller) of ``rounds`` rounds."""
     t0 = time.perf_counter()
-    br = run_bridged_battle(_spec(1, BRIDGE_BOT, rounds), policy, EngineOptions(seed=seed, cpu_constant_ms=cpu_ms),
-                            every=every, controller=policy.control)
+    br = run_bridged_battle(_spec(1, BRIDGE_BOT, rounds), policy, opts, every=every, controller=policy.control)
     rec = _record("1v1", f"check {rounds} rounds", 0, br.run, time.perf_counter() - t0, br)
-    print(f"\n{rounds}-round bridged 1v1 (T={every}, controller in Java, CPU constant {cpu_ms} ms): "
+    print(f"\n{rounds}-round bridged 1v1 (T={every}, controller in Java, CPU constant {opts.cpu_constant_ms} ms): "
           f"{rec['skipped_turns']} skipped turns, {rec['failures']} fallbacks, {rec['decisions']} decisions, "
           f"mean round trip {rec['rtt_mean_us']:.0f} us ({rec['rtt_over_1ms']} over 1 ms), set-up wait "
           f"{rec['setup_s']:.1f} s of {rec['elapsed_s']:.1f} s, "
@@ -234,7 +233,7 @@ def main() -> None:
                           f"load {os.getloadavg()[0]:.1f}", flush=True)
         report(records)
         if args.check_rounds:
-            records.append(check_skipped(args.check_rounds, args.every, args.cpu_ms, args.seed, policy))
+            records.append(check_skipped(args.check_rounds, args.every, opts, policy))
     print(f"load average at end {os.getloadavg()[0]:.1f}")
     if args.json:
         args.json.write_text(json.dumps(records, indent=1))

@@ -52,7 +52,8 @@ from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # no
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
 
-__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
+__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "team_members", "LEARNER",
+           "REWARDS", "SAMPLE_TEAMS"]
 
 LEARNER = "td"  # opponents value meaning "learning tanks driven by the caller"
 REWARDS = {"eq35": 0, "score": 1}  # per-turn reward: Eq. 35 against the target, or the team's score margin
@@ -129,21 +130,41 @@ class StepResult:
     info: dict[str, Any] = field(default_factory=dict)
 
 
+# Robocode's sample team (sampleteam.MyFirstTeam): its leader first, then droids to fill the team
+SAMPLE_TEAMS = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
+
+
+def team_members(name: str, size: int) -> list[str]:
+    """The robots of a team of ``size`` named ``name``: a sample team's leader and droids, or ``size`` copies of a
+    bot (a team of 1 cannot be a sample team: its leader alone has no droid to command)."""
+    if name not in SAMPLE_TEAMS:
+        return [name] * size
+    if size < 2:
+        raise ValueError(f"{name} needs teams of 2 or more robots (a leader and droids), got a team of {size}")
+    leader, droid = SAMPLE_TEAMS[name]
+    return [leader] + [droid] * (size - 1)
+
+
 def resolve_drivers(scenario: Scenario, opponents: str | list[str] | tuple[str, ...] | None) -> list[str | None]:
     """Per-robot driver: None = learning tank, or a bot name. Team 0 always learns.
 
-    ``opponents``: None = the scenario's default; one name for every robot of the other teams; or one name
-    per robot of the other teams (in robot order). ``"td"`` means learning tanks.
+    ``opponents``: None = the scenario's default; one name for every robot of the other teams (a sample team,
+    ``"MyFirstTeam"``, fills each of them with its leader and droids); or one name per robot of the other teams
+    (in robot order). ``"td"`` means learning tanks.
     """
     others = scenario.n_robots - scenario.teams[0]
     if opponents is None:
         opponents = scenario.opponents
-    names = [opponents] * others if isinstance(opponents, str) else list(opponents)
+    if isinstance(opponents, str):
+        names = [n for size in scenario.teams[1:] for n in team_members(opponents, size)]
+    else:
+        names = list(opponents)
     if len(names) != others:
         raise ValueError(f"opponents has {len(names)} entries, the other teams have {others} robots")
     for n in names:
         if n != LEARNER and n not in BOT_NAMES:
-            raise ValueError(f"unknown opponent {n!r}; use {LEARNER!r} or one of {', '.join(BOT_NAMES)}")
+            raise ValueError(f"unknown opponent {n!r}; use {LEARNER!r}, one of {', '.join(BOT_NAMES)} or a sample "
+                             f"team ({', '.join(SAMPLE_TEAMS)})")
     return [None] * scenario.teams[0] + [None if n == LEARNER else n for n in names]
 
 

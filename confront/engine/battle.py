@@ -12,6 +12,9 @@ SAMPLE_ROBOTS: tuple[str, ...] = (
     "Target", "VelociRobot", "MyFirstRobot",
 )
 TEAM_PACKAGE = "confrontteams"
+# robots of Robocode's sample team (package sampleteam), and the team itself: its leader, then droids
+SAMPLE_TEAM_ROBOTS: tuple[str, ...] = ("MyFirstLeader", "MyFirstDroid")
+SAMPLE_TEAMS: dict[str, tuple[str, str]] = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
 
 
 @dataclass(frozen=True)
@@ -52,8 +55,11 @@ def robot_class(name: str) -> str:
         raise ValueError(f"bad robot name {name!r}")
     if "." in name:
         return name
+    if name in SAMPLE_TEAM_ROBOTS:
+        return f"sampleteam.{name}"
     if name not in SAMPLE_ROBOTS:
-        raise ValueError(f"unknown robot {name!r}: give a package-qualified class or one of {SAMPLE_ROBOTS}")
+        raise ValueError(f"unknown robot {name!r}: give a package-qualified class or one of "
+                         f"{SAMPLE_ROBOTS + SAMPLE_TEAM_ROBOTS}")
     return f"sample.{name}"
 
 
@@ -140,6 +146,11 @@ SCENARIO_SIZES: dict[str, tuple[int, ...]] = {
 
 
 def _side(label: str, size: int, robots: Sequence[str]) -> Contestant:
+    if len(robots) == 1 and robots[0] in SAMPLE_TEAMS:  # a sample team: its leader, then droids
+        if size < 2:
+            raise ValueError(f"{robots[0]} needs a side of 2 or more robots (a leader and droids), got {size}")
+        leader, droid = SAMPLE_TEAMS[robots[0]]
+        return Team(f"{robots[0]}{size}", (leader,) + (droid,) * (size - 1))
     members = tuple(robots[i % len(robots)] for i in range(size))
     if size == 1:
         return members[0]
@@ -154,7 +165,8 @@ def scenario_battle(
     width: int = 800,
     height: int = 600,
 ) -> BattleSpec:
-    """Battle for a named scenario: our side vs opponents, teams filled by cycling the given robots.
+    """Battle for a named scenario: our side vs opponents, teams filled by cycling the given robots (a sample team's
+    name, ``"MyFirstTeam"``, fills a side with its leader and droids).
 
     For ``melee`` the four robots are ``ours`` followed by ``opponents`` cycled.
     """
@@ -166,6 +178,8 @@ def scenario_battle(
         raise ValueError("ours and opponents must each name at least one robot")
     sizes = SCENARIO_SIZES[scenario]
     if scenario == "melee":
+        if any(o in SAMPLE_TEAMS for o in opp_l):
+            raise ValueError("a sample team needs a side of 2 or more robots (a leader and droids); a melee has none")
         pool = ours_l[:1] + [opp_l[i % len(opp_l)] for i in range(3)]
         conts: tuple[Contestant, ...] = tuple(pool)
     else:

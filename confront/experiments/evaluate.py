@@ -11,6 +11,7 @@ from typing import Any
 import click
 import numpy as np
 
+from confront.arena.scenarios import Scenario
 from confront.arena.smdp import TeamBattleEnv
 from confront.config import load_toml
 from confront.experiments.episodes import Loop, Side, load_model, scenario_of, smdp_config
@@ -128,10 +129,15 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
     from confront.arena.bots import BOT_NAMES
+    from confront.arena.smdp import SAMPLE_TEAMS
 
     for name in names:
-        if name != "td" and name not in BOT_NAMES:
-            raise click.UsageError(f"unknown opponent {name!r} in --opponents: use td or {', '.join(BOT_NAMES)}")
+        if name != "td" and name not in BOT_NAMES and name not in SAMPLE_TEAMS:
+            raise click.UsageError(f"unknown opponent {name!r} in --opponents: use td, {', '.join(BOT_NAMES)} or a "
+                                   f"sample team ({', '.join(SAMPLE_TEAMS)})")
+        if name in SAMPLE_TEAMS and min(scenario_of(cfg.arena.scenario).teams[1:]) < 2:
+            raise click.UsageError(f"{name} is a leader and droids: the run's scenario {cfg.arena.scenario} has no "
+                                   "other team of 2 or more robots")
     seeds = disjoint_seeds(seed, sim_seeds, rounds)
     lines = [f"| opponent | rounds | score ratio (simulator) | simulator, {sim_seeds} seeds (min-max) "
              "| score ratio (robocode) | difference |", "|---|---:|---:|---:|---:|---:|"]
@@ -159,7 +165,8 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
 
 
 def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int, n_battles: int = 1) -> BattleResults:
-    """Scripted robots in the simulator: one name per team (a team is filled with copies of its robot).
+    """Scripted robots in the simulator: one name per team (a team is filled with copies of its robot, or with a
+    sample team's leader and droids).
 
     ``n_battles = 1`` plays one battle of ``rounds`` rounds as Robocode does (robots such as Corners remember
     across rounds; with the engine's seed the start positions and processing order are the engine's); more
@@ -169,14 +176,24 @@ def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int, n_b
     from confront.arena.scoring import results_table
 
     sc = scenario_of(scenario)
-    if len(robots) != len(sc.teams):
-        raise click.UsageError(f"scenario {sc.name} has {len(sc.teams)} teams: give {len(sc.teams)} robots, "
-                               f"got {','.join(robots)}")
     team = np.asarray(sc.team_ids())
-    parts, places = bot_battle([robots[t] for t in team], rounds, seed=seed, n_battles=n_battles, scenario=sc)
+    parts, places = bot_battle(_robot_names(sc, robots), rounds, seed=seed, n_battles=n_battles, scenario=sc)
     labels = [name if size == 1 else f"{name} team {k}"
               for k, (name, size) in enumerate(zip(robots, sc.teams, strict=True))]
     return results_table(parts, places, team, labels, rounds=rounds)
+
+
+def _robot_names(sc: Scenario, robots: list[str]) -> list[str]:
+    """One bot name per robot from one name per team (copies of a robot, or a sample team's leader and droids)."""
+    from confront.arena.smdp import team_members
+
+    if len(robots) != len(sc.teams):
+        raise click.UsageError(f"scenario {sc.name} has {len(sc.teams)} teams: give {len(sc.teams)} robots, "
+                               f"got {','.join(robots)}")
+    try:
+        return [n for name, size in zip(robots, sc.teams, strict=True) for n in team_members(name, size)]
+    except ValueError as err:
+        raise click.UsageError(str(err)) from None
 
 
 def record_bot_round(scenario: str, robots: list[str], seed: int, out: Path) -> Path:
@@ -187,9 +204,8 @@ def record_bot_round(scenario: str, robots: list[str], seed: int, out: Path) -> 
     from confront.arena.core import Arena
 
     sc = scenario_of(scenario)
-    team = sc.team_ids()
     arena = Arena(sc.replace(max_turns=100000), 1, seed=seed)
-    names = [robots[t] for t in team]
+    names = _robot_names(sc, robots)
     bots = ScriptedBots(arena, names)
     replay = rp.new_replay(arena, [f"{n} ({i})" for i, n in enumerate(names)])
     cmd = arena.idle_commands()
@@ -210,13 +226,15 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
                replay_out: Path | None, battles: int = 1) -> None:
     sc = scenario_of(scenario)
     from confront.arena.bots import BOT_NAMES
+    from confront.arena.smdp import SAMPLE_TEAMS
 
     default = [("SpinBot", "Walls", "Tracker", "RamFire", "Crazy", "Fire", "Corners", "SittingDuck")[i % 8]
                for i in range(len(sc.teams))]
     names = [r.strip() for r in robots.split(",")] if robots else default
     for n in names:
-        if n not in BOT_NAMES:
-            raise click.UsageError(f"unknown robot {n!r}: use {', '.join(BOT_NAMES)}")
+        if n not in BOT_NAMES and n not in SAMPLE_TEAMS:
+            raise click.UsageError(f"unknown robot {n!r}: use {', '.join(BOT_NAMES)} or a sample team "
+                                   f"({', '.join(SAMPLE_TEAMS)})")
     if battles < 1:
         raise click.UsageError(f"--battles must be >= 1, got {battles}")
     if engine == "robocode":

@@ -15,9 +15,10 @@ from typing import Literal
 from confront.config import ConfigError, field, from_dict, load_toml, merge, parse_override, to_dict
 
 CONFIG_PACKAGE = "confront.experiments.configs"
-# scripted robots of confront.arena.bots.BOT_NAMES known without loading the simulator (a name outside these is
-# checked against BOT_NAMES itself)
-SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy")
+# the sample robots of confront.arena.bots.BOT_NAMES that fight on their own, and its sample teams (a leader and
+# droids), known without loading the simulator (a test keeps them equal)
+SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire")
+SAMPLE_TEAMS = ("MyFirstTeam",)
 RUN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 
 
@@ -67,12 +68,12 @@ class OpponentSection:
 
     def __post_init__(self) -> None:
         for key, value in (("kind", self.kind), ("pretrain_against", self.pretrain_against)):
-            if value in SCRIPTED_BOTS or (key == "kind" and value == "td"):
+            if value in SCRIPTED_BOTS or (key == "kind" and value in ("td", *SAMPLE_TEAMS)):
                 continue
             from confront.arena.bots import BOT_NAMES
 
             if value not in BOT_NAMES:
-                allowed = ("td", *BOT_NAMES) if key == "kind" else BOT_NAMES
+                allowed = ("td", *BOT_NAMES, *SAMPLE_TEAMS) if key == "kind" else BOT_NAMES
                 raise ValueError(f"opponent.{key} = {value!r} is not allowed: use one of {', '.join(allowed)}")
 
 
@@ -185,7 +186,8 @@ class LeagueSection:
         ("1v1:SittingDuck", "1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Fire", "1v1:Corners",
          "1v1:Crazy", "1v1:dodge", "1v1:self", "4v4:SpinBot", "4v4:Walls", "4v4:Tracker", "4v4:RamFire",
          "4v4:Crazy", "4v4:td", "4v4:dodge", "4v4:self"),
-        doc="SCENARIO:OPPONENT entries: a scripted robot (a team of it), td, random, dodge, strafe, or self "
+        doc="SCENARIO:OPPONENT entries: a scripted robot (a team of it), a sample team (MyFirstTeam: a leader and "
+        "droids, in scenarios whose other teams have 2 or more robots), td, random, dodge, strafe, or self "
         "(snapshots)")
     battles: int = field(8, ge=1, le=4096, doc="battles per entry")
     focus: tuple[str, ...] = field((), doc="entries of opponents that get focus_weight times the battles; one "
@@ -195,14 +197,17 @@ class LeagueSection:
     snapshots: int = field(5, ge=1, le=100, doc="snapshots kept; self-play battles sample one per update")
 
     def __post_init__(self) -> None:
-        from confront.arena.scenarios import scenario_names
+        from confront.arena.scenarios import get_scenario, scenario_names
 
+        kinds = (*SCRIPTED_BOTS, *SAMPLE_TEAMS, "td", "random", "dodge", "strafe", "self")
         for e in self.opponents:
             scen, _, opp = e.partition(":")
-            if scen not in scenario_names() or opp not in (*SCRIPTED_BOTS, "td", "random", "dodge", "strafe", "self"):
+            if scen not in scenario_names() or opp not in kinds:
                 raise ValueError(f"league.opponents entry {e!r} is not allowed: use SCENARIO:OPPONENT with a "
-                                 f"scenario of {', '.join(scenario_names())} and an opponent of "
-                                 f"{', '.join(SCRIPTED_BOTS)}, td, random, dodge, strafe, self")
+                                 f"scenario of {', '.join(scenario_names())} and an opponent of {', '.join(kinds)}")
+            if opp in SAMPLE_TEAMS and min(get_scenario(scen).teams[1:]) < 2:
+                raise ValueError(f"league.opponents entry {e!r} is not allowed: {opp} is a leader and droids, so the "
+                                 f"other teams of the scenario need 2 or more robots")
         if not self.opponents:
             raise ValueError("league.opponents must not be empty")
         for e in self.focus:
@@ -262,6 +267,14 @@ class ExperimentConfig:
             raise ValueError(
                 f"train.session_rounds = {self.train.session_rounds} exceeds train.rounds = {self.train.rounds}"
             )
+        if self.opponent.kind in SAMPLE_TEAMS:
+            from confront.arena.scenarios import get_scenario, load_scenario
+
+            scen = self.arena.scenario
+            teams = (load_scenario(scen) if scen.endswith(".toml") else get_scenario(scen)).teams
+            if min(teams[1:]) < 2:
+                raise ValueError(f"opponent.kind = {self.opponent.kind!r} is a leader and droids: arena.scenario = "
+                                 f"{scen!r} needs other teams of 2 or more robots")
 
 
 def list_experiments() -> list[str]:

@@ -528,6 +528,7 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
     entry, ``seeds`` battles of ``rounds`` rounds (engine seeds ``seed``, ``seed + 1``, ...): our score ratio
     per battle."""
     from confront.arena.bots import BOT_NAMES
+    from confront.arena.smdp import SAMPLE_TEAMS
     from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
     from confront.experiments.spec import config_from_dict, load_toml
 
@@ -539,7 +540,7 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
     click.echo("| opponent | battles | score ratio (robocode) |\n|---|---:|---:|")
     for entry in league_entries(opponents, cfg):
         scen, _, opp = entry.partition(":")
-        if opp not in BOT_NAMES:
+        if opp not in BOT_NAMES and opp not in SAMPLE_TEAMS:
             click.echo(f"| {entry} | - | simulator only |")
             continue
         out[entry] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed + k)[1] for k in range(seeds)]

@@ -52,7 +52,7 @@ from confront.engine.export import export_robot
 from confront.engine.install import find_engine
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 from confront.engine.tank_export import TANK_CPU_CONSTANT_MS, TANK_ROBOT, TankPolicy, export_tank_robot
-from confront.experiments.spec import SCRIPTED_BOTS, ExperimentConfig
+from confront.experiments.spec import SAMPLE_TEAMS, SCRIPTED_BOTS, ExperimentConfig
 from confront.experiments.tanks import (
     PAPER_MOVE_OPPONENTS,
     load_tank_model,
@@ -200,9 +200,10 @@ def engine_entries(cfg: ExperimentConfig) -> tuple[str, ...]:
         if scen not in SCENARIO_SIZES:
             raise ConfigError(f"league.opponents entry {e!r}: the engine plays the scenarios "
                               f"{', '.join(sorted(SCENARIO_SIZES))}")
-        if opp not in SCRIPTED_BOTS and opp not in PAPER_MOVE_OPPONENTS:
+        if opp not in SCRIPTED_BOTS and opp not in SAMPLE_TEAMS and opp not in PAPER_MOVE_OPPONENTS:
             raise ConfigError(f"league.opponents entry {e!r} cannot be played in the engine: use a sample robot "
-                              f"({', '.join(SCRIPTED_BOTS)}) or a paper-move opponent "
+                              f"({', '.join(SCRIPTED_BOTS)}), a sample team ({', '.join(SAMPLE_TEAMS)}) or a "
+                              "paper-move opponent "
                               f"({', '.join(PAPER_MOVE_OPPONENTS)}); {opp!r} exists only in the simulator")
     return tuple(cfg.league.opponents)
 

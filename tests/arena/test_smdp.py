@@ -197,3 +197,18 @@ def test_battle_group_must_be_a_positive_integer() -> None:
             env.battle_group = bad
     env.battle_group = 1
     assert env.battle_group == 1
+
+
+def test_a_sample_team_fills_each_other_team_with_its_leader_and_droids() -> None:
+    assert resolve_drivers(get_scenario("4v4"), "MyFirstTeam") == [None] * 4 + ["MyFirstLeader"] + ["MyFirstDroid"] * 3
+    assert resolve_drivers(get_scenario("4v6"), "MyFirstTeam")[4:] == ["MyFirstLeader"] + ["MyFirstDroid"] * 5
+    assert resolve_drivers(get_scenario("4v4"), "TrackFire")[4:] == ["TrackFire"] * 4
+    for name in ("1v1", "melee"):  # a leader alone has no droid to command
+        with pytest.raises(ValueError, match="MyFirstTeam needs teams of 2 or more robots"):
+            resolve_drivers(get_scenario(name), "MyFirstTeam")
+    env = TeamBattleEnv("4v4", 1, seed=0, opponents="MyFirstTeam")
+    env.reset()
+    s = env.arena.state
+    assert s.is_droid[0].tolist() == [False] * 5 + [True] * 3
+    assert s.is_leader[0].tolist() == [True, False, False, False, True, False, False, False]
+    assert s.energy[0].tolist() == [200.0, 100.0, 100.0, 100.0, 200.0, 120.0, 120.0, 120.0]  # leaders 200, droids 120

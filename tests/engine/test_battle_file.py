@@ -36,6 +36,20 @@ def test_scenarios_build_teams() -> None:
     assert melee.contestants == ("sample.SpinBot", "sample.Walls", "sample.Tracker", "sample.Walls")
 
 
+def test_a_sample_team_is_its_leader_and_droids() -> None:
+    spec = scenario_battle("4v6", "SpinBot", "MyFirstTeam")
+    them = spec.contestants[1]
+    assert isinstance(them, Team) and them.name == "MyFirstTeam6"
+    assert them.members == ("sampleteam.MyFirstLeader",) + ("sampleteam.MyFirstDroid",) * 5
+    assert them.team_file().startswith("team.members=sampleteam.MyFirstLeader,sampleteam.MyFirstDroid,")
+    assert robot_class("MyFirstDroid") == "sampleteam.MyFirstDroid"
+    assert scenario_battle("1v1", "SpinBot", "TrackFire").contestants == ("sample.SpinBot", "sample.TrackFire")
+    with pytest.raises(ValueError, match="a side of 2 or more robots"):
+        scenario_battle("1v1", "SpinBot", "MyFirstTeam")
+    with pytest.raises(ValueError, match="a melee has none"):
+        scenario_battle("melee", "SpinBot", "MyFirstTeam")
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [

@@ -30,7 +30,22 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Scenario", "get_scenario", "load_scenario", "scenario_names", "scenario_from_dict"]
+__all__ = ["Scenario", "get_scenario", "load_scenario", "scenario_names", "scenario_from_dict", "SAMPLE_TEAMS",
+           "team_members"]
+
+# Robocode's sample team (sampleteam.MyFirstTeam): its leader first, then droids to fill the team
+SAMPLE_TEAMS = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
+
+
+def team_members(name: str, size: int) -> list[str]:
+    """The robots of a team of ``size`` named ``name``: a sample team's leader and droids, or ``size`` copies of a
+    robot (a team of 1 cannot be a sample team: its leader alone has no droid to command)."""
+    if name not in SAMPLE_TEAMS:
+        return [name] * size
+    if size < 2:
+        raise ValueError(f"{name} needs teams of 2 or more robots (a leader and droids), got a team of {size}")
+    leader, droid = SAMPLE_TEAMS[name]
+    return [leader] + [droid] * (size - 1)
 
 
 @dataclass(frozen=True)

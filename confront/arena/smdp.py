@@ -47,13 +47,12 @@ from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
 from .core import Arena, run_parallel
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
-from .scenarios import Scenario, get_scenario
+from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, team_members
 from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # noqa: F401 - re-exported
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
 
-__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "team_members", "LEARNER",
-           "REWARDS", "SAMPLE_TEAMS"]
+__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
 
 LEARNER = "td"  # opponents value meaning "learning tanks driven by the caller"
 REWARDS = {"eq35": 0, "score": 1}  # per-turn reward: Eq. 35 against the target, or the team's score margin
@@ -128,21 +127,6 @@ class StepResult:
     final_features: np.ndarray | None = None
     round_end: RoundEnd | None = None
     info: dict[str, Any] = field(default_factory=dict)
-
-
-# Robocode's sample team (sampleteam.MyFirstTeam): its leader first, then droids to fill the team
-SAMPLE_TEAMS = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
-
-
-def team_members(name: str, size: int) -> list[str]:
-    """The robots of a team of ``size`` named ``name``: a sample team's leader and droids, or ``size`` copies of a
-    bot (a team of 1 cannot be a sample team: its leader alone has no droid to command)."""
-    if name not in SAMPLE_TEAMS:
-        return [name] * size
-    if size < 2:
-        raise ValueError(f"{name} needs teams of 2 or more robots (a leader and droids), got a team of {size}")
-    leader, droid = SAMPLE_TEAMS[name]
-    return [leader] + [droid] * (size - 1)
 
 
 def resolve_drivers(scenario: Scenario, opponents: str | list[str] | tuple[str, ...] | None) -> list[str | None]:

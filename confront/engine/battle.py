@@ -7,14 +7,15 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
+from confront.arena.scenarios import SAMPLE_TEAMS, team_members
+
 SAMPLE_ROBOTS: tuple[str, ...] = (
     "SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire",
     "Target", "VelociRobot", "MyFirstRobot",
 )
 TEAM_PACKAGE = "confrontteams"
-# robots of Robocode's sample team (package sampleteam), and the team itself: its leader, then droids
-SAMPLE_TEAM_ROBOTS: tuple[str, ...] = ("MyFirstLeader", "MyFirstDroid")
-SAMPLE_TEAMS: dict[str, tuple[str, str]] = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
+# the robots of Robocode's sample teams (package sampleteam)
+SAMPLE_TEAM_ROBOTS: tuple[str, ...] = tuple(r for team in SAMPLE_TEAMS.values() for r in team)
 
 
 @dataclass(frozen=True)
@@ -147,10 +148,7 @@ SCENARIO_SIZES: dict[str, tuple[int, ...]] = {
 
 def _side(label: str, size: int, robots: Sequence[str]) -> Contestant:
     if len(robots) == 1 and robots[0] in SAMPLE_TEAMS:  # a sample team: its leader, then droids
-        if size < 2:
-            raise ValueError(f"{robots[0]} needs a side of 2 or more robots (a leader and droids), got {size}")
-        leader, droid = SAMPLE_TEAMS[robots[0]]
-        return Team(f"{robots[0]}{size}", (leader,) + (droid,) * (size - 1))
+        return Team(f"{robots[0]}{size}", tuple(team_members(robots[0], size)))
     members = tuple(robots[i % len(robots)] for i in range(size))
     if size == 1:
         return members[0]
@@ -178,8 +176,8 @@ def scenario_battle(
         raise ValueError("ours and opponents must each name at least one robot")
     sizes = SCENARIO_SIZES[scenario]
     if scenario == "melee":
-        if any(o in SAMPLE_TEAMS for o in opp_l):
-            raise ValueError("a sample team needs a side of 2 or more robots (a leader and droids); a melee has none")
+        for o in opp_l:
+            team_members(o, 1)  # a sample team cannot fight alone
         pool = ours_l[:1] + [opp_l[i % len(opp_l)] for i in range(3)]
         conts: tuple[Contestant, ...] = tuple(pool)
     else:

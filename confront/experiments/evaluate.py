@@ -129,7 +129,7 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
     from confront.arena.bots import BOT_NAMES
-    from confront.arena.smdp import SAMPLE_TEAMS
+    from confront.arena.scenarios import SAMPLE_TEAMS
 
     for name in names:
         if name != "td" and name not in BOT_NAMES and name not in SAMPLE_TEAMS:
@@ -185,7 +185,7 @@ def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int, n_b
 
 def _robot_names(sc: Scenario, robots: list[str]) -> list[str]:
     """One bot name per robot from one name per team (copies of a robot, or a sample team's leader and droids)."""
-    from confront.arena.smdp import team_members
+    from confront.arena.scenarios import team_members
 
     if len(robots) != len(sc.teams):
         raise click.UsageError(f"scenario {sc.name} has {len(sc.teams)} teams: give {len(sc.teams)} robots, "
@@ -226,7 +226,7 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
                replay_out: Path | None, battles: int = 1) -> None:
     sc = scenario_of(scenario)
     from confront.arena.bots import BOT_NAMES
-    from confront.arena.smdp import SAMPLE_TEAMS
+    from confront.arena.scenarios import SAMPLE_TEAMS
 
     default = [("SpinBot", "Walls", "Tracker", "RamFire", "Crazy", "Fire", "Corners", "SittingDuck")[i % 8]
                for i in range(len(sc.teams))]

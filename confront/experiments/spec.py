@@ -12,13 +12,13 @@ from importlib import resources
 from pathlib import Path
 from typing import Literal
 
+from confront.arena.scenarios import SAMPLE_TEAMS
 from confront.config import ConfigError, field, from_dict, load_toml, merge, parse_override, to_dict
 
 CONFIG_PACKAGE = "confront.experiments.configs"
-# the sample robots of confront.arena.bots.BOT_NAMES that fight on their own, and its sample teams (a leader and
-# droids), known without loading the simulator (a test keeps them equal)
+# the sample robots of confront.arena.bots.BOT_NAMES that fight on their own, known without loading the simulator (a
+# test keeps them equal); the sample teams (a leader and droids) are SAMPLE_TEAMS
 SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire")
-SAMPLE_TEAMS = ("MyFirstTeam",)
 RUN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 
 

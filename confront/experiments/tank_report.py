@@ -157,7 +157,7 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
     real_runs: dict[str, list[list[float]]] = {}  # per engine run, its battles
     if engine:
         from confront.arena.bots import BOT_NAMES
-        from confront.arena.smdp import SAMPLE_TEAMS
+        from confront.arena.scenarios import SAMPLE_TEAMS
         from confront.engine.tank_export import load_tank_policy
 
         policy = load_tank_policy(runs[0], play)

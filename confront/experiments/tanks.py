@@ -528,7 +528,7 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
     entry, ``seeds`` battles of ``rounds`` rounds (engine seeds ``seed``, ``seed + 1``, ...): our score ratio
     per battle."""
     from confront.arena.bots import BOT_NAMES
-    from confront.arena.smdp import SAMPLE_TEAMS
+    from confront.arena.scenarios import SAMPLE_TEAMS
     from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
     from confront.experiments.spec import config_from_dict, load_toml
 

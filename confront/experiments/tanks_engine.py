@@ -45,6 +45,7 @@ import numpy as np
 
 from confront import checkpoint as ck
 from confront.arena.control import ControlConfig
+from confront.arena.scenarios import SAMPLE_TEAMS
 from confront.arena.tank import FEATURE_NAMES
 from confront.config import ConfigError
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, scenario_battle, single_star
@@ -52,7 +53,7 @@ from confront.engine.export import export_robot
 from confront.engine.install import find_engine
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 from confront.engine.tank_export import TANK_CPU_CONSTANT_MS, TANK_ROBOT, TankPolicy, export_tank_robot
-from confront.experiments.spec import SAMPLE_TEAMS, SCRIPTED_BOTS, ExperimentConfig
+from confront.experiments.spec import SCRIPTED_BOTS, ExperimentConfig
 from confront.experiments.tanks import (
     PAPER_MOVE_OPPONENTS,
     load_tank_model,

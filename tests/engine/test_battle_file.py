@@ -44,10 +44,9 @@ def test_a_sample_team_is_its_leader_and_droids() -> None:
     assert them.team_file().startswith("team.members=sampleteam.MyFirstLeader,sampleteam.MyFirstDroid,")
     assert robot_class("MyFirstDroid") == "sampleteam.MyFirstDroid"
     assert scenario_battle("1v1", "SpinBot", "TrackFire").contestants == ("sample.SpinBot", "sample.TrackFire")
-    with pytest.raises(ValueError, match="a side of 2 or more robots"):
-        scenario_battle("1v1", "SpinBot", "MyFirstTeam")
-    with pytest.raises(ValueError, match="a melee has none"):
-        scenario_battle("melee", "SpinBot", "MyFirstTeam")
+    for scenario in ("1v1", "melee"):
+        with pytest.raises(ValueError, match="MyFirstTeam needs teams of 2 or more robots"):
+            scenario_battle(scenario, "SpinBot", "MyFirstTeam")
 
 
 @pytest.mark.parametrize(

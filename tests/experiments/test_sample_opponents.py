@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from confront.arena import bots, smdp
-from confront.arena.scenarios import get_scenario
+from confront.arena import bots
+from confront.arena.scenarios import SAMPLE_TEAMS, get_scenario
 from confront.cli.main import cli
 from confront.config import ConfigError
 from confront.engine import battle
@@ -17,11 +17,11 @@ from confront.experiments.spec import load_experiment
 
 
 def test_the_opponent_names_agree_everywhere() -> None:
-    assert set(spec.SCRIPTED_BOTS) | {r for team in smdp.SAMPLE_TEAMS.values() for r in team} == set(bots.BOT_NAMES)
-    assert spec.SAMPLE_TEAMS == tuple(smdp.SAMPLE_TEAMS) == tuple(battle.SAMPLE_TEAMS)
-    assert battle.SAMPLE_TEAMS == smdp.SAMPLE_TEAMS
+    members = {r for team in SAMPLE_TEAMS.values() for r in team}
+    assert set(spec.SCRIPTED_BOTS) | members == set(bots.BOT_NAMES)
     assert set(spec.SCRIPTED_BOTS) <= set(battle.SAMPLE_ROBOTS)
-    assert set(battle.SAMPLE_TEAM_ROBOTS) == {r for team in smdp.SAMPLE_TEAMS.values() for r in team}
+    assert set(battle.SAMPLE_TEAM_ROBOTS) == members
+    assert spec.SAMPLE_TEAMS is SAMPLE_TEAMS
 
 
 def test_configs_take_them_where_they_fit() -> None:

@@ -18,7 +18,9 @@ def _numbers(markdown: str) -> list[list[str]]:
 
 @pytest.mark.parametrize("seed", [1, 2])
 def test_myfirstteam_battle_is_the_engines(install: EngineInstall, seed: int) -> None:
-    run = run_scenario("4v4", "SpinBot", "MyFirstTeam", rounds=3, seed=seed)
+    # generous CPU time: at the default 10 ms a robot that skips a turn under load plays another battle
+    run = run_scenario("4v4", "SpinBot", "MyFirstTeam", rounds=3, seed=seed, cpu_constant_ms=100.0)
+    assert run.skipped_turns == {}
     sim = sim_bot_battle("4v4", ["SpinBot", "MyFirstTeam"], 3, seed)
     engine_rows = _numbers(run.results.to_markdown())
     assert "confrontteams.MyFirstTeam4" in run.results.to_markdown()

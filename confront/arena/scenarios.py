@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["Scenario", "get_scenario", "load_scenario", "scenario_names", "scenario_from_dict", "SAMPLE_TEAMS",
-           "team_members"]
+           "team_members", "opponent_members"]
 
 # Robocode's sample team (sampleteam.MyFirstTeam): its leader first, then droids to fill the team
 SAMPLE_TEAMS = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
@@ -111,6 +111,12 @@ class Scenario:
         d = {f.name: getattr(self, f.name) for f in fields(self)}
         d.update(changes)
         return scenario_from_dict(d)
+
+
+def opponent_members(scenario: Scenario, name: str) -> list[str]:
+    """One robot name per robot of the scenario's other teams when ``name`` plays them all (copies of a robot, or each
+    team a sample team's leader and droids); ValueError if a sample team meets a team of 1."""
+    return [n for size in scenario.teams[1:] for n in team_members(name, size)]
 
 
 _FIELDS = {f.name for f in fields(Scenario)}

@@ -47,7 +47,7 @@ from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
 from .core import Arena, run_parallel
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
-from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, team_members
+from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, opponent_members
 from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # noqa: F401 - re-exported
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
@@ -139,10 +139,7 @@ def resolve_drivers(scenario: Scenario, opponents: str | list[str] | tuple[str, 
     others = scenario.n_robots - scenario.teams[0]
     if opponents is None:
         opponents = scenario.opponents
-    if isinstance(opponents, str):
-        names = [n for size in scenario.teams[1:] for n in team_members(opponents, size)]
-    else:
-        names = list(opponents)
+    names = opponent_members(scenario, opponents) if isinstance(opponents, str) else list(opponents)
     if len(names) != others:
         raise ValueError(f"opponents has {len(names)} entries, the other teams have {others} robots")
     for n in names:

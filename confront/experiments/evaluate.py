@@ -129,15 +129,16 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").exists() else {}
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
     from confront.arena.bots import BOT_NAMES
-    from confront.arena.scenarios import SAMPLE_TEAMS
+    from confront.arena.scenarios import SAMPLE_TEAMS, opponent_members
 
     for name in names:
         if name != "td" and name not in BOT_NAMES and name not in SAMPLE_TEAMS:
             raise click.UsageError(f"unknown opponent {name!r} in --opponents: use td, {', '.join(BOT_NAMES)} or a "
                                    f"sample team ({', '.join(SAMPLE_TEAMS)})")
-        if name in SAMPLE_TEAMS and min(scenario_of(cfg.arena.scenario).teams[1:]) < 2:
-            raise click.UsageError(f"{name} is a leader and droids: the run's scenario {cfg.arena.scenario} has no "
-                                   "other team of 2 or more robots")
+        try:
+            opponent_members(scenario_of(cfg.arena.scenario), name)
+        except ValueError as err:
+            raise click.UsageError(f"--opponents {name} in the run's scenario {cfg.arena.scenario}: {err}") from None
     seeds = disjoint_seeds(seed, sim_seeds, rounds)
     lines = [f"| opponent | rounds | score ratio (simulator) | simulator, {sim_seeds} seeds (min-max) "
              "| score ratio (robocode) | difference |", "|---|---:|---:|---:|---:|---:|"]

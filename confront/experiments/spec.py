@@ -197,7 +197,7 @@ class LeagueSection:
     snapshots: int = field(5, ge=1, le=100, doc="snapshots kept; self-play battles sample one per update")
 
     def __post_init__(self) -> None:
-        from confront.arena.scenarios import get_scenario, scenario_names
+        from confront.arena.scenarios import get_scenario, opponent_members, scenario_names
 
         kinds = (*SCRIPTED_BOTS, *SAMPLE_TEAMS, "td", "random", "dodge", "strafe", "self")
         for e in self.opponents:
@@ -205,9 +205,10 @@ class LeagueSection:
             if scen not in scenario_names() or opp not in kinds:
                 raise ValueError(f"league.opponents entry {e!r} is not allowed: use SCENARIO:OPPONENT with a "
                                  f"scenario of {', '.join(scenario_names())} and an opponent of {', '.join(kinds)}")
-            if opp in SAMPLE_TEAMS and min(get_scenario(scen).teams[1:]) < 2:
-                raise ValueError(f"league.opponents entry {e!r} is not allowed: {opp} is a leader and droids, so the "
-                                 f"other teams of the scenario need 2 or more robots")
+            try:
+                opponent_members(get_scenario(scen), opp)
+            except ValueError as err:
+                raise ValueError(f"league.opponents entry {e!r} is not allowed: {err}") from None
         if not self.opponents:
             raise ValueError("league.opponents must not be empty")
         for e in self.focus:
@@ -268,13 +269,15 @@ class ExperimentConfig:
                 f"train.session_rounds = {self.train.session_rounds} exceeds train.rounds = {self.train.rounds}"
             )
         if self.opponent.kind in SAMPLE_TEAMS:
-            from confront.arena.scenarios import get_scenario, load_scenario
+            from confront.arena.scenarios import get_scenario, load_scenario, opponent_members
 
             scen = self.arena.scenario
-            teams = (load_scenario(scen) if scen.endswith(".toml") else get_scenario(scen)).teams
-            if min(teams[1:]) < 2:
-                raise ValueError(f"opponent.kind = {self.opponent.kind!r} is a leader and droids: arena.scenario = "
-                                 f"{scen!r} needs other teams of 2 or more robots")
+            try:
+                opponent_members(load_scenario(scen) if scen.endswith(".toml") else get_scenario(scen),
+                                 self.opponent.kind)
+            except ValueError as err:
+                raise ValueError(f"opponent.kind = {self.opponent.kind!r} with arena.scenario = {scen!r}: {err}") \
+                    from None
 
 
 def list_experiments() -> list[str]:

@@ -21,7 +21,6 @@ def test_the_opponent_names_agree_everywhere() -> None:
     assert set(spec.SCRIPTED_BOTS) | members == set(bots.BOT_NAMES)
     assert set(spec.SCRIPTED_BOTS) <= set(battle.SAMPLE_ROBOTS)
     assert set(battle.SAMPLE_TEAM_ROBOTS) == members
-    assert spec.SAMPLE_TEAMS is SAMPLE_TEAMS
 
 
 def test_configs_take_them_where_they_fit() -> None:
@@ -30,9 +29,9 @@ def test_configs_take_them_where_they_fit() -> None:
     assert cfg.league.opponents == ("1v1:TrackFire", "4v4:MyFirstTeam", "4v10:MyFirstTeam")
     assert load_experiment("demo", ["opponent.kind=MyFirstTeam"]).opponent.kind == "MyFirstTeam"
     assert load_experiment("demo", ["opponent.kind=TrackFire", "arena.scenario=1v1"]).opponent.kind == "TrackFire"
-    with pytest.raises(ConfigError, match="'1v1:MyFirstTeam' is not allowed: MyFirstTeam is a leader and droids"):
+    with pytest.raises(ConfigError, match="'1v1:MyFirstTeam' is not allowed: MyFirstTeam needs teams of 2 or more"):
         load_experiment("tanks", ['league.opponents=["1v1:MyFirstTeam"]', "league.focus=[]"])
-    with pytest.raises(ConfigError, match="arena.scenario = 'melee' needs other teams of 2 or more robots"):
+    with pytest.raises(ConfigError, match="arena.scenario = 'melee': MyFirstTeam needs teams of 2 or more robots"):
         load_experiment("demo", ["opponent.kind=MyFirstTeam", "arena.scenario=melee"])
 
 

@@ -180,7 +180,7 @@ def test_demo_contrast_windows_and_figure(tmp_path) -> None:
 
 @pytest.mark.parametrize(("override", "message"), [
     ('league.opponents=["1v1:nope"]', "league.opponents entry '1v1:nope'"),
-    ('league.opponents=["1v1:MyFirstTeam"]', "MyFirstTeam is a leader and droids"),
+    ('league.opponents=["1v1:MyFirstTeam"]', "'1v1:MyFirstTeam' is not allowed: MyFirstTeam needs teams of 2"),
     ('tank.leads=["sideways"]', "tank.leads entry 'sideways'"),
     ("tank.fire_powers=[0.05]", "tank.fire_powers"),
     ('league.focus=["1v1:SpinBot*x"]', "the weight after '*' must be an integer in 1..64"),

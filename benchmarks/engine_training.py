@@ -23,7 +23,9 @@ round's first turn; a lost round-start wake-up would add min(300 x CPU constant,
 robots were held up per decision (as the robots timed it: sending the observation, and waiting for the
 acknowledgements that count for the move, ``RobotActing.wait``), how many decisions went ahead of
 acknowledgements that could not change them, the server's time per decision inside the policy (learning) and
-its own (parse, updates, send), the CPU seconds of this process and of the engine processes (its waited
+its own (parse, updates, send), the learning robots' own time per turn outside ``execute()`` (BridgeBot's energy
+record and controller every turn, its decisions with their sends and waits: the engine time the exported robot
+does not spend), the CPU seconds of this process and of the engine processes (its waited
 children), and x exported = train wall / exported wall of the same repetition.
 Before any timing, one untimed training of ``--warmup-rounds`` rounds and its exported robot's battle warm up what
 a first run pays once per process (imports of torch's TensorBoard writer and matplotlib, loading the compiled
@@ -40,6 +42,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import os
 import resource
 import statistics
@@ -116,6 +119,9 @@ def _record(mode: str, rep: int, wall: float, cpu0: tuple[float, float], battles
     rec["held_up_us"] = per_decision("rtt_mean_us")
     rec["held_up_s"] = rec["held_up_us"] * n / 1e6 if n else None
     rec["policy_us"], rec["server_us"] = per_decision("policy_us"), per_decision("handling_us")
+    timed = [br for br in bridged if math.isfinite(br.work_us_per_turn)]  # per turn, weighted by the battles' turns
+    turns = sum(br.run.turns for br in timed)
+    rec["work_us"] = sum(br.work_us_per_turn * br.run.turns for br in timed) / turns if turns else None
     rec["behind"] = sum(br.behind for br in bridged) if bridged else None
     rec["ahead"] = sum(getattr(br, "ahead", 0) for br in bridged) if bridged else None
     rec["failures"] = sum(len(br.failures) + len(br.server_errors) for br in bridged) if bridged else None
@@ -174,7 +180,7 @@ COLUMNS = (("wall s", "wall_s", 1), ("in battles s", "battles_s", 1), ("outside 
            ("set-up ms/round", "setup_ms_per_round", 0), ("turns", "turns", 0),
            ("skipped", "skipped_turns", 0), ("decisions", "decisions", 0), ("held up us/decision", "held_up_us", 0),
            ("held up s", "held_up_s", 1), ("went ahead", "ahead", 0), ("policy us", "policy_us", 0),
-           ("server us", "server_us", 0),
+           ("server us", "server_us", 0), ("robot work us/turn", "work_us", 1),
            ("Python CPU s", "python_cpu_s", 1), ("engine CPU s", "engine_cpu_s", 1), ("load", "load", 1),
            ("x exported", "ratio", 2))
 
@@ -258,7 +264,7 @@ def main() -> None:
               "median_ratio": statistics.median(ratios), "ratios": ratios,
               "train_wall_s": med("train", "wall_s"), "exported_wall_s": med("exported", "wall_s"),
               "train_setup_s": med("train", "setup_s"), "exported_setup_s": med("exported", "setup_s"),
-              "held_up_us": med("train", "held_up_us"),
+              "held_up_us": med("train", "held_up_us"), "robot_work_us_per_turn": med("train", "work_us"),
               # a lost round-start wake-up costs min(300 x CPU constant, 10 s) [RobotPeer.startRound]
               "lost_wakeup_s": min(0.3 * args.cpu_ms, 10.0), "max_setup_s": max(r["setup_s"] for r in records),
               "load_average_start": list(load0), "load_average_end": list(load1),

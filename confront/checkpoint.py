@@ -21,6 +21,7 @@ rows) are stored as columns in ``state.npz`` (``table.<key>.<i>``, their names i
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import os
 import re
@@ -30,7 +31,7 @@ import tempfile
 import zipfile
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
@@ -48,7 +49,7 @@ class CheckpointError(RuntimeError):
 
 def rng_state(rng: np.random.Generator) -> dict[str, Any]:
     """A Generator's full state as JSON-ready data."""
-    return rng.bit_generator.state
+    return dict(rng.bit_generator.state)
 
 
 def rng_from_state(state: Mapping[str, Any]) -> np.random.Generator:
@@ -99,6 +100,25 @@ def write_atomic(path: Path, data: bytes) -> None:
         raise
 
 
+def npz_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
+    """``arrays`` as the bytes of an uncompressed .npz (data only: it loads with ``allow_pickle=False``)."""
+    buf = io.BytesIO()
+    _savez(buf, arrays)
+    return buf.getvalue()
+
+
+def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
+    """``arrays`` as an uncompressed .npz at ``path``, written atomically (:func:`write_atomic`)."""
+    write_atomic(path, npz_bytes(arrays))
+
+
+def _savez(fh: IO[bytes], arrays: Mapping[str, np.ndarray]) -> None:
+    named: dict[str, Any] = dict(arrays)  # keys are array names, never np.savez's own keyword allow_pickle
+    if "allow_pickle" in named:
+        raise ValueError("'allow_pickle' cannot name an array")
+    np.savez(fh, **named)
+
+
 def _as_columns(rows: Any) -> list[tuple[str, np.ndarray]] | None:
     """A list of flat rows with one key order and one scalar type (bool, int, float, str) per column as (name,
     array) columns; None if ``rows`` is not such a table."""
@@ -107,7 +127,7 @@ def _as_columns(rows: Any) -> list[tuple[str, np.ndarray]] | None:
     keys = list(rows[0])
     if any(list(r) != keys for r in rows):
         return None
-    out = []
+    out: list[tuple[str, np.ndarray]] = []
     for k in keys:
         values = [r[k] for r in rows]
         kind = {type(v) for v in values}
@@ -149,7 +169,7 @@ def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], met
     try:
         npz = tmp / "state.npz"
         with npz.open("wb") as fh:
-            np.savez(fh, **arrays)
+            _savez(fh, arrays)
             fh.flush()
             os.fsync(fh.fileno())
         full_meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "sha256": _sha256(npz), **meta}

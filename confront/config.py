@@ -130,7 +130,7 @@ def _coerce(key: str, value: Any, tp: Any) -> Any:
         else:
             items = list(value)
         return tuple(items) if origin is tuple or tp is tuple else items
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         if not isinstance(value, Mapping):
             raise ConfigError(f"{key} = {_show(value)} has the wrong type: expected a table of {_type_name(tp)} keys")
         return from_dict(tp, value, prefix=key)

@@ -10,6 +10,7 @@ import csv
 import io
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields, replace
 
 # Columns of Robocode's results table, in its order ("Ram Dmg * 2" is already doubled by the engine).
@@ -46,10 +47,20 @@ class ScoreRow:
     thirds: int = 0
     team: str = ""
 
+    @classmethod
+    def of(cls, name: str, total: float, parts: Sequence[float], places: Sequence[int] = (0, 0, 0),
+           team: str = "") -> ScoreRow:
+        """A row from the six score parts after the total (survival .. ram bonus, table order) and the counts of
+        1sts, 2nds and 3rds."""
+        survival, surv_bonus, bullet_dmg, bullet_bonus, ram_dmg, ram_bonus = parts
+        firsts, seconds, thirds = places
+        return cls(name, total, survival, surv_bonus, bullet_dmg, bullet_bonus, ram_dmg, ram_bonus, firsts, seconds,
+                   thirds, team)
+
     def rounded(self) -> ScoreRow:
         """The row as the engine prints it: every score part rounded half up."""
-        parts = {f: round_half_up(getattr(self, f)) for f in SCORE_FIELDS[:7]}
-        return replace(self, **parts)
+        r = [round_half_up(getattr(self, f)) for f in SCORE_FIELDS[:7]]
+        return ScoreRow.of(self.name, r[0], r[1:], (self.firsts, self.seconds, self.thirds), self.team)
 
     def values(self) -> tuple[float, ...]:
         """The ten score columns in table order."""
@@ -149,6 +160,6 @@ def parse_results_text(text: str) -> BattleResults:
         if m is None or len(cells) != 11:
             raise ValueError(f"bad results row: {line!r}")
         total = float(cells[1].split()[0])
-        nums = [float(c) for c in cells[2:8]] + [int(c) for c in cells[8:11]]
-        rows.append(ScoreRow(m.group(2), total, *nums, team=m.group(2)))  # type: ignore[arg-type]
+        rows.append(ScoreRow.of(m.group(2), total, [float(c) for c in cells[2:8]], [int(c) for c in cells[8:11]],
+                                team=m.group(2)))
     return BattleResults(rounds=rounds, contestants=tuple(rows))

@@ -27,6 +27,7 @@ round (``state.round`` changed) clears the memory of that battle's bots by itsel
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numba import njit
@@ -840,7 +841,7 @@ def play_range(b0, b1, turns, kinds, mem, rounds, rf, rb, ri, bi, bf, bb, kf, ki
 class ScriptedBots:
     """Sample-robot behaviour for some robots of an Arena (all battles)."""
 
-    def __init__(self, arena: Arena, names: list[str | None]) -> None:
+    def __init__(self, arena: Arena, names: Sequence[str | None]) -> None:
         if len(names) != arena.n_robots:
             raise ValueError(f"names has {len(names)} entries, the arena has {arena.n_robots} robots")
         self.arena = arena

@@ -22,6 +22,8 @@ from .core import Arena
 from .observe import Sensing, TargetRule, perceive, remember_scans, select_targets
 from .rules import java_atan2_ufunc, java_hypot_ufunc
 
+Floats = np.ndarray | float  # an array, or one value (a scalar works wherever an array does)
+
 __all__ = ["ControlConfig", "nearest_enemy", "move_commands", "gun_radar_commands", "aim", "remember",
            "known_targets", "N_MOVES", "MOVE_NAMES"]
 
@@ -77,8 +79,8 @@ def power_for_distance(dist: np.ndarray, cfg: ControlConfig) -> np.ndarray:
                     np.where(dist < cfg.far_distance, cfg.power_mid, cfg.power_far))
 
 
-def aim(x: np.ndarray, y: np.ndarray, gun_heading: np.ndarray, radar_heading: np.ndarray,
-        gun_heat: np.ndarray, energy: np.ndarray, tx: np.ndarray, ty: np.ndarray, has: np.ndarray,
+def aim(x: Floats, y: Floats, gun_heading: Floats, radar_heading: Floats, gun_heat: Floats, energy: Floats,
+        tx: Floats, ty: Floats, has: np.ndarray | bool | np.bool_,
         cfg: ControlConfig = ControlConfig()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(gun turn, radar turn, fire power) toward (tx, ty) where ``has``; elsewhere (NaN = keep, 2 pi, 0).
 
@@ -108,7 +110,8 @@ def known_targets(view: tuple[np.ndarray, ...], team: np.ndarray, rule: TargetRu
     vx, vy, ve, va = view
     b, r = vx.shape[:2]
     team_b = np.repeat(np.broadcast_to(np.asarray(team), (b, r)), r, axis=0)
-    t = select_targets(*(v.reshape(b * r, r) for v in (vx, vy, ve, va)), team_b, rule)
+    fx, fy, fe, fa = (v.reshape(b * r, r) for v in (vx, vy, ve, va))
+    t = select_targets(fx, fy, fe, fa, team_b, rule)
     return t.reshape(b, r, r)[:, np.arange(r), np.arange(r)]
 
 

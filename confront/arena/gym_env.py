@@ -39,7 +39,7 @@ from gymnasium import spaces
 from .observe import N_STATES, ObservationConfig
 from .render import FrameData, draw_frame
 from .scenarios import Scenario, get_scenario
-from .smdp import SMDPConfig, StepResult, TeamBattleEnv
+from .smdp import Reward, SMDPConfig, StepResult, TeamBattleEnv
 from .state import SCORE_PARTS
 from .tank import TankSpace, feature_names
 
@@ -53,7 +53,7 @@ OtherPolicy = Callable[[np.ndarray, np.ndarray, np.random.Generator], np.ndarray
 
 def make_config(turns_per_step: int | None = None, fire_power_actions: bool = False,
                 config: SMDPConfig | None = None, view: str = "paper", tank: TankSpace | None = None,
-                reward: str | None = None, **kwargs: Any) -> SMDPConfig:
+                reward: Reward | None = None, **kwargs: Any) -> SMDPConfig:
     """An SMDPConfig from keyword arguments (or the one given): ``view="paper"`` (the paper's state and moves,
     Eq. 35 rewards, T = 10) or ``"tank"`` (the tank view and actions, ``tank`` or ``TankSpace()``, the score
     margin as reward, scanned sensing, T = 5: what the recommended learner trains on)."""
@@ -122,7 +122,7 @@ def action_indices(cfg: SMDPConfig, actions: Any, n: int) -> np.ndarray:
             or (a >= np.array(dims)).any():
         raise ValueError(f"a tank action is {len(dims)} head indices below {list(dims)} (distance, turn, fire, "
                          f"target slot, lead), for each of {n}; got {actions!r}")
-    return np.ravel_multi_index(tuple(a.reshape(n, len(dims)).astype(np.int64).T), dims).astype(np.int64)
+    return np.asarray(np.ravel_multi_index(tuple(a.reshape(n, len(dims)).astype(np.int64).T), dims), dtype=np.int64)
 
 
 class AgentDriver:
@@ -181,7 +181,7 @@ class BattleEnv(gym.Env):
                  fire_power_actions: bool = False, config: SMDPConfig | None = None,
                  other_policy: OtherPolicy | None = None, render_mode: str | None = None,
                  render_scale: float = 0.5, seed: int = 0, order: str = "engine", view: str = "paper",
-                 tank: TankSpace | None = None, reward: str | None = None) -> None:
+                 tank: TankSpace | None = None, reward: Reward | None = None) -> None:
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         cfg = make_config(turns_per_step, fire_power_actions, config, view, tank, reward)

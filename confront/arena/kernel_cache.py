@@ -63,7 +63,7 @@ def prebuilt_dir() -> Path | None:
     from numba.core import config
     from numba.core.codegen import get_host_cpu_features
 
-    if config.CPU_NAME is not None or config.CPU_FEATURES is not None:
+    if config.CPU_NAME is not None or config.CPU_FEATURES is not None:  # type: ignore[attr-defined]
         return None  # the user chose the code's target CPU
     host = {f[1:] for f in get_host_cpu_features().split(",") if f.startswith("+")}
     if not host.issuperset(TARGET_FEATURES):
@@ -125,6 +125,7 @@ def install(namespace: dict[str, Any]) -> None:
     (call it at the module's end, and before anything there compiles them)."""
     module = namespace["__name__"]
     for obj in list(namespace.values()):
-        if isinstance(obj, Dispatcher) and obj.py_func.__module__ == module and isinstance(obj._cache, FunctionCache) \
-                and not isinstance(obj._cache, KernelCache):
-            obj._cache = KernelCache(obj.py_func)
+        cache = getattr(obj, "_cache", None)  # numba's private cache slot of a Dispatcher
+        if isinstance(obj, Dispatcher) and obj.py_func.__module__ == module and isinstance(cache, FunctionCache) \
+                and not isinstance(cache, KernelCache):
+            obj._cache = KernelCache(obj.py_func)  # type: ignore[attr-defined]

@@ -375,9 +375,9 @@ def robot_observation(x: np.ndarray, y: np.ndarray, h: np.ndarray, e: np.ndarray
     if feat.shape[0] > 7:
         feat[7] = x[i] / width
         feat[8] = y[i] / height
-    return state_index_scalar(angle_bin(rel, N_REL_BINS, True),
-                              angle_bin(normal_absolute_angle(h[i]), N_HEADING_BINS, False),
-                              distance_bin(dist, max_distance, N_DIST_BINS))
+    return int(state_index_scalar(angle_bin(rel, N_REL_BINS, True),
+                                  angle_bin(normal_absolute_angle(h[i]), N_HEADING_BINS, False),
+                                  distance_bin(dist, max_distance, N_DIST_BINS)))
 
 
 @njit(cache=True)

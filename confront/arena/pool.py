@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -131,7 +132,8 @@ class PoolEnv:
             results = [env.step(full) for env, full in zip(self.envs, full_actions, strict=True)]
         else:
             results = self._step_together(full_actions)
-        obs, rew, done, active, rounds = [], [], [], [], []
+        obs, rew, done, active = [], [], [], []
+        rounds: list[dict[str, float | str | bool]] = []
         for k, (entry, res) in enumerate(zip(self.entries, results, strict=True)):
             ours = self.ours[k]
             self._disc[k], self._feats[k] = res.discrete, res.features
@@ -155,7 +157,7 @@ class PoolEnv:
         begun = [env._begin(full) for env, full in zip(self.envs, full_actions, strict=True)]
         workers = _pool()._max_workers
         whole = len(self.envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
-        calls = []
+        calls: list[tuple[int, tuple[Any, ...]]] = []
         for k, (env, (rewards, _, obs)) in enumerate(zip(self.envs, begun, strict=True)):
             calls.extend((k, c) for c in env._kernel_calls(0, env.turns_per_step, rewards, obs, whole=whole))
         calls.sort(key=lambda kc: -(kc[1][1] - kc[1][0]) * self.envs[kc[0]].n_robots)  # largest first

@@ -23,7 +23,7 @@ from pettingzoo import ParallelEnv
 from .gym_env import AgentDriver, OtherPolicy, action_indices, agent_obs, make_config, make_spaces
 from .render import draw_frame
 from .scenarios import Scenario, get_scenario
-from .smdp import SMDPConfig
+from .smdp import Reward, SMDPConfig
 from .state import SCORE_PARTS
 from .tank import TankSpace
 
@@ -39,7 +39,7 @@ class TeamParallelEnv(ParallelEnv):
                  fire_power_actions: bool = False, config: SMDPConfig | None = None,
                  other_policy: OtherPolicy | None = None, render_mode: str | None = None, seed: int = 0,
                  order: str = "engine", view: str = "paper", tank: TankSpace | None = None,
-                 reward: str | None = None) -> None:
+                 reward: Reward | None = None) -> None:
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         sc = get_scenario(scenario) if isinstance(scenario, str) else scenario

@@ -467,7 +467,7 @@ def float_from_bits(typingctx, b):  # noqa: ARG001
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _high_word(a: float) -> int:
     """The upper 32 bits of the IEEE representation of a positive finite double (fdlibm's __HI)."""
-    return float_bits(a) >> 32
+    return float_bits(a) >> 32  # type: ignore[call-arg]  # an intrinsic: numba passes the typing context
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
@@ -508,7 +508,7 @@ def java_atan2(y: float, x: float) -> float:
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _from_high_word(hw: int) -> float:
     """The positive double whose upper 32 bits are hw and lower 32 bits zero."""
-    return float_from_bits(np.int64(hw) << 32)
+    return float_from_bits(np.int64(hw) << 32)  # type: ignore[call-arg]  # an intrinsic (as above)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")

@@ -53,7 +53,7 @@ def results_table(score_total: np.ndarray, placements_total: np.ndarray, team: n
     n_teams = len(names)
     ts = team_scores(score_total[None], team, n_teams)[0]
     tp = team_placements(placements_total[None], team, n_teams)[0]
-    rows = [ScoreRow(names[k], float(ts[k].sum()), *map(float, ts[k]), firsts=int(tp[k, 0]), seconds=int(tp[k, 1]),
-                     thirds=int(tp[k, 2]), team=names[k]) for k in range(n_teams)]
+    rows = [ScoreRow.of(names[k], float(ts[k].sum()), [float(v) for v in ts[k]], [int(v) for v in tp[k, :3]],
+                        team=names[k]) for k in range(n_teams)]
     rows.sort(key=lambda r: -r.total)
     return BattleResults(rounds=rounds, contestants=tuple(rows), engine="sim")

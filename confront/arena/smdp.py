@@ -52,6 +52,8 @@ from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # no
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
 
+Reward = Literal["eq35", "score"]  # Eq. 35 per turn, or the change of the team's score margin
+
 __all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
 
 LEARNER = "td"  # opponents value meaning "learning tanks driven by the caller"
@@ -68,7 +70,7 @@ class SMDPConfig:
     auto_reset: bool = True
     observation: ObservationConfig = field(default_factory=ObservationConfig)
     control: ControlConfig = field(default_factory=ControlConfig)
-    reward: Literal["eq35", "score"] = "eq35"
+    reward: Reward = "eq35"
     tank: TankSpace | None = None  # the tank view and tank actions (confront.arena.tank) instead of the paper's
 
     def __post_init__(self) -> None:
@@ -441,9 +443,9 @@ class TeamBattleEnv:
         res = StepResult(disc, feats, target, rewards, terminated, round_done, truncated, active)
         res.info = {"score": s["score"].copy(), "score_total": s["score_total"].copy(), "score_parts": SCORE_PARTS}
         if round_done.any():
-            s = self.arena.state
-            res.round_end = RoundEnd(round_done, s.score.copy(), s.placements.copy(), s.time.copy(),
-                                     s.decided.copy(), s.alive.copy())
+            st = self.arena.state
+            res.round_end = RoundEnd(round_done, st.score.copy(), st.placements.copy(), st.time.copy(),
+                                     st.decided.copy(), st.alive.copy())
             if self.config.auto_reset:
                 res.final_discrete, res.final_features = disc.copy(), feats.copy()
                 self.arena.reset(round_done)  # scripted bots clear their memory on the new round themselves

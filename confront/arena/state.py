@@ -26,7 +26,7 @@ B_NONE, B_FIRED, B_MOVING, B_HIT_VICTIM, B_HIT_BULLET, B_HIT_WALL, B_EXPLODED = 
 
 # Packed groups: every field is a view into one array per group, shape (B, n_fields, ...) so that the
 # kernel takes few arguments and each battle's data is contiguous. Index constants are the positions.
-RF_FIELDS = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "energy", "gun_heat",
+RF_FIELDS: tuple[str, ...] = ("x", "y", "heading", "gun_heading", "radar_heading", "velocity", "energy", "gun_heat",
              "box_x", "box_y", "distance_remaining", "body_turn_remaining", "gun_turn_remaining",
              "radar_turn_remaining", "max_velocity", "max_turn_rate", "fire_assist",
              "ev_hit_wall_bearing", "ev_hit_robot_bearing", "ev_hit_by_bullet_bearing", "ev_hit_by_bullet_heading")
@@ -131,7 +131,7 @@ def allocate(scenario: Scenario, n_battles: int) -> ArenaState:
     packed: dict[str, np.ndarray] = {}
     arrays: dict[str, np.ndarray] = {}
     for gname, (names, kind, dt) in GROUPS.items():
-        arr = np.zeros((b, len(names)) + tail[kind], dtype=dt)
+        arr: np.ndarray = np.zeros((b, len(names)) + tail[kind], dtype=dt)
         packed[gname] = arr
         for i, name in enumerate(names):
             arrays[name] = arr[:, i]

@@ -18,7 +18,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from .gym_env import AgentDriver, OtherPolicy, action_indices, agent_obs, make_config, make_spaces
 from .scenarios import Scenario
-from .smdp import SMDPConfig
+from .smdp import Reward, SMDPConfig
 from .state import SCORE_PARTS
 from .tank import TankSpace
 
@@ -34,7 +34,7 @@ class BattleVectorEnv(VectorEnv):
                  turns_per_step: int | None = None, fire_power_actions: bool = False,
                  config: SMDPConfig | None = None, other_policy: OtherPolicy | None = None, seed: int = 0,
                  order: str = "engine", render_mode: str | None = None, view: str = "paper",
-                 tank: TankSpace | None = None, reward: str | None = None) -> None:
+                 tank: TankSpace | None = None, reward: Reward | None = None) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
         if render_mode not in (None, "rgb_array"):
@@ -69,7 +69,7 @@ class BattleVectorEnv(VectorEnv):
         """Hold each sub-environment's action for T turns; ended episodes restart at once."""
         a = action_indices(self.config, actions, self.num_envs).reshape(self.num_envs, 1)
         drv = self._driver
-        res = drv.env.step(drv.full_actions(a, self._np_random))
+        res = drv.env.step(drv.full_actions(a, self.np_random))
         rewards = res.rewards[:, 0].sum(axis=1)
         truncated = res.truncated.copy()
         terminated = res.terminated[:, 0] & ~truncated

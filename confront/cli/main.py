@@ -6,7 +6,7 @@ import json
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import click
 
@@ -119,7 +119,7 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
     if resume is not None:
         summary = train_run(None, resume, resume=True, progress=not quiet, engine=engine)
     else:
-        extra = (f"train.seed={seed}",) if seed is not None else ()
+        extra: tuple[str, ...] = (f"train.seed={seed}",) if seed is not None else ()
         if init is not None:  # absolute: the run's config.toml must find it from anywhere
             extra += (f"train.init={json.dumps(str(init.resolve()))}",)
         cfg = load_experiment(config, overrides + extra)
@@ -200,11 +200,11 @@ def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: in
               "the default), or take the first maximum of each head.")
 def export(run: Path, out: Path, play: str | None) -> None:
     """Export a trained policy as a standalone Robocode robot (no Python needed to run it)."""
-    from confront.engine.tank_export import export_tank_cli, is_tank_run
+    from confront.engine.tank_export import Play, export_tank_cli, is_tank_run
     from confront.experiments.evaluate import export_cli
 
     if is_tank_run(run):  # a PPO run over the tank view: confront.TankBot
-        export_tank_cli(run, out=out, play=play or "sampled")
+        export_tank_cli(run, out=out, play=cast(Play, play or "sampled"))  # click checked it is one of the two
         return
     if play is not None:
         raise click.UsageError("--play is for PPO tank runs (paper policies play their own rule)")

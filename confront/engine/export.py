@@ -67,7 +67,8 @@ class ExportedPolicy:
             raise ValueError(f"ties must be 'first' or 'random', got {self.ties!r}")
         if self.kind == "qtable":
             if self.q is None or np.shape(self.q) != (N_STATES, 4) or not np.all(np.isfinite(self.q)):
-                raise ValueError(f"q must be a finite ({N_STATES}, 4) array, got shape {np.shape(self.q)}")
+                got = "none" if self.q is None else f"shape {np.shape(self.q)}"
+                raise ValueError(f"q must be a finite ({N_STATES}, 4) array, got {got}")
         else:
             if not self.weights or len(self.weights) != len(self.biases):
                 raise ValueError("mlp needs as many weight matrices as bias vectors (at least one)")

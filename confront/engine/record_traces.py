@@ -223,7 +223,8 @@ def record(battle: ScriptedBattle, out: Path, cpu_constant_ms: float = 20.0) -> 
         for t, c, v in r.commands:
             slot = by_turn.setdefault(t, [{} for _ in battle.robots])
             slot[i][c] = float(v)
-    names = next((ln for ln in lines if ln["type"] in ("round_end", "stopped")), {"robots": []})["robots"]
+    end: dict[str, Any] = next((ln for ln in lines if ln["type"] in ("round_end", "stopped")), {"robots": []})
+    names: list[dict[str, Any]] = end["robots"]
     header.update({
         "format": TRACE_FORMAT, "version": TRACE_VERSION, "engine": f"robocode {ENGINE_VERSION}",
         "name": battle.name, "description": battle.description, "seed": battle.seed,

@@ -26,7 +26,7 @@ import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -37,6 +37,8 @@ from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point
 from confront.engine.export import ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
 from confront.results import BattleResults
+
+Play = Literal["greedy", "sampled"]  # the most likely action, or one drawn from the policy
 
 __all__ = ["TankPolicy", "PLAYS", "sample_heads", "robot_view", "robot_target", "robot_control", "body_turn",
            "turn_rate", "export_tank_robot", "evaluate_tank_policy", "is_tank_run", "load_tank_policy", "TANK_CLASSES",
@@ -193,7 +195,7 @@ class TankPolicy:
     space: TankSpace = field(default_factory=TankSpace)
     control: ControlConfig = field(default_factory=ControlConfig)
     step_turns: int = 5
-    play: Literal["greedy", "sampled"] = "greedy"
+    play: Play = "greedy"
 
     def __post_init__(self) -> None:
         if self.play not in PLAYS:
@@ -340,13 +342,14 @@ def is_tank_run(run: str | Path) -> bool:
     return isinstance(info, dict) and info.get("kind") == "ppo"
 
 
-def load_tank_policy(run: str | Path, play: Literal["greedy", "sampled"] = "greedy") -> TankPolicy:
+def load_tank_policy(run: str | Path, play: Play = "greedy") -> TankPolicy:
     """The policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``, playing ``play``."""
     folder = _model_dir(run)
     cfg = json.loads((folder / "tank.json").read_text(encoding="utf-8"))
     tank_cfg = cfg.get("tank", cfg)
     names = {f.name for f in fields(TankSpace)}
-    space = TankSpace(**{k: tuple(v) if isinstance(v, list) else v for k, v in tank_cfg.items() if k in names})
+    given: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in tank_cfg.items() if k in names}
+    space = TankSpace(**given)
     ctl_cfg = cfg.get("control", cfg)
     control = ControlConfig(**{f.name: ctl_cfg[f.name] for f in fields(ControlConfig) if f.name in ctl_cfg})
     step = cfg.get("step_turns", cfg.get("turns_per_step"))
@@ -359,7 +362,7 @@ def load_tank_policy(run: str | Path, play: Literal["greedy", "sampled"] = "gree
     return replace(TankPolicy.from_state(state, space, control, int(step)), play=play)
 
 
-def export_tank_cli(run: str | Path, out: str | Path, play: Literal["greedy", "sampled"] = "sampled") -> Path:
+def export_tank_cli(run: str | Path, out: str | Path, play: Play = "sampled") -> Path:
     """``confront export`` for a PPO run: write confront.TankBot (playing ``play``) and say where."""
     import click
 

@@ -32,7 +32,7 @@ from collections.abc import Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -110,7 +110,7 @@ class BaselinesConfig:
 
 # -- the SB3 adapter ---------------------------------------------------------------------------------------------
 
-class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
+class SharedTeamVecEnv(_VecEnvBase):
     """SB3 ``VecEnv`` over a TeamBattleEnv: one sub-environment per (battle, tank of team 0).
 
     Sub-environment ``k = b * n_ours + j`` is tank ``j`` of team 0 in battle ``b``. Observation: the
@@ -126,6 +126,8 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
                  td: Learner | None = None, config: SMDPConfig | None = None) -> None:
         if not HAVE_SB3:
             raise ImportError("SharedTeamVecEnv needs stable-baselines3: pip install 'confront[baselines]'")
+        from gymnasium import spaces
+
         from confront.arena.gym_env import make_spaces
 
         self.env = TeamBattleEnv(scenario, n_battles=n_battles, seed=seed, opponents=opponents, config=config)
@@ -146,7 +148,9 @@ class SharedTeamVecEnv(_VecEnvBase):  # type: ignore[misc,valid-type]
         self._feats = np.zeros((n_battles, self.env.n_robots, self.env.n_features), dtype=np.float32)
         obs_space, act_space = make_spaces(self.env.config)
         n = n_battles * self.ours.size
-        super().__init__(n, obs_space["features"] if self.env.config.tank is None else obs_space, act_space)
+        if self.env.config.tank is None:  # the paper's Dict: SB3 sees its features
+            obs_space = cast(spaces.Dict, obs_space)["features"]
+        super().__init__(n, obs_space, act_space)
 
     def _flat(self, feats: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(feats[:, self.ours].reshape(self.num_envs, -1), dtype=np.float32)
@@ -385,7 +389,6 @@ def train_sb3(algo: str, cfg: BaselinesConfig, seed: int, rounds: int) -> tuple[
 def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folder: Path,
                 dmnn_folder: Path | None) -> list[dict[str, Any]]:
     """Train (if needed) and evaluate one method at one seed; cached in ``folder/result.json``."""
-    import io
 
     from confront import checkpoint as ck
     from confront.experiments.episodes import load_model, td_team
@@ -403,9 +406,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
         td_path = Path(info.pop("td_model"))
         extra.update(info)
         folder.mkdir(parents=True, exist_ok=True)
-        buf = io.BytesIO()
-        np.savez(buf, **policy.state_dict())
-        ck.write_atomic(folder / "policy.npz", buf.getvalue())
+        ck.write_npz(folder / "policy.npz", policy.state_dict())
     elif method == DMNN_METHOD:
         if dmnn_folder is None:
             raise ValueError("the DMNN method needs its run folder")

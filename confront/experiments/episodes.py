@@ -66,8 +66,8 @@ def smdp_config(cfg: ExperimentConfig) -> SMDPConfig:
 def build_learner(cfg: ExperimentConfig, n_features: int, n_actions: int) -> Learner:
     """The learning team's learner from the config (shared by every tank: parameter sharing, §4.2)."""
     lc = cfg.learner
-    common = dict(n_actions=n_actions, gamma=lc.gamma, alpha=lc.alpha, rate=lc.learning_rate, backup=lc.backup,
-                  exploration="boltzmann", t_max=lc.t_max, t_min=lc.t_min, eta=lc.eta)
+    common: dict[str, Any] = dict(n_actions=n_actions, gamma=lc.gamma, alpha=lc.alpha, rate=lc.learning_rate,
+                                  backup=lc.backup, exploration="boltzmann", t_max=lc.t_max, t_min=lc.t_min, eta=lc.eta)
     if lc.kind == "ssaq":
         return make_learner("ssaq", n_states=320, **common)
     if lc.kind == "random":

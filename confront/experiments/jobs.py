@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 __all__ = ["VERDICTS", "Job", "Claim", "Outcome", "run_jobs", "slug"]
 
@@ -117,7 +118,7 @@ def run_jobs(jobs: Sequence[Job], rounds: int | None, workers: int, engine: str 
                 bar.update(1)
             return
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            running = {}
+            running: dict[Future[Any], Job] = {}
             while waiting or running:
                 ready = [j for j in waiting if all(a in done for a in j.after)]
                 for job in ready[: max(0, workers * 2 - len(running))]:

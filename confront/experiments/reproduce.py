@@ -357,8 +357,7 @@ def restate_claim(c: dict, seeds: int) -> Claim:
                      detail=c.get("detail", ""))
     m, band = _LEVEL.match(ours), _BAND.search(c.get("detail", ""))
     if m and band:
-        _name, mean, lo, hi = m.groups()
-        mean, lo, hi = float(mean), float(lo), float(hi)
+        mean, lo, hi = (float(v) for v in m.groups()[1:])
         target, tol = map(float, band.groups())
         se = (hi - lo) / 3.92
         p = 2 * stats.t.sf(abs(mean - target) / se, seeds - 1) if se > 0 else float("nan")

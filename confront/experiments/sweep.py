@@ -131,7 +131,7 @@ def aggregate(out: Path, trials: list[Trial]) -> list[dict]:
     for t in trials:
         summary = json.loads((out / "trials" / t.name / "summary.json").read_text())
         by_point.setdefault(t.point, []).append(float(summary["final_score_ratio"]))
-    rows = []
+    rows: list[dict[str, Any]] = []
     for point, values in by_point.items():
         m, lo, hi = bootstrap_ci(np.array(values), rng)
         rows.append({"point": point, "seeds": len(values), "final_score_ratio": float(m), "ci_lo": float(lo),

@@ -38,7 +38,6 @@ of ``--rounds`` rounds (engine seed ``--engine-seed``) per entry, against the sa
 from __future__ import annotations
 
 import argparse
-import io
 import json
 import re
 from dataclasses import replace
@@ -117,9 +116,7 @@ def _baseline_policy(method: str, seed: int, work: Path, td_name: str) -> tuple[
         policy = SB3Policy(model, int(model.action_space.n))
         folder = work / "sb3-ppo" / f"seed-{seed}"
         folder.mkdir(parents=True, exist_ok=True)
-        buf = io.BytesIO()
-        np.savez(buf, **policy.state_dict())
-        ck.write_atomic(folder / "policy.npz", buf.getvalue())
+        ck.write_npz(folder / "policy.npz", policy.state_dict())
         ck.write_atomic(folder / "train.json", json.dumps({**info, "activation": sb3_activation(model)},
                                                           indent=1).encode())
         return policy, exp
@@ -201,7 +198,7 @@ def engine_method_shares(method: str, seed: int, entries: list[str], td_model: s
     from confront.experiments.episodes import load_model
 
     path = work / "engine" / _result_file(method, seed)
-    key = {"method": method, "seed": seed, "rounds": rounds, "engine_seed": engine_seed,
+    key: dict[str, Any] = {"method": method, "seed": seed, "rounds": rounds, "engine_seed": engine_seed,
            "td_team": Path(td_model).name}
     cached = json.loads(path.read_text()) if path.is_file() else {}
     shares: dict[str, float] = dict(cached["shares"]) if all(cached.get(k) == v for k, v in key.items()) else {}

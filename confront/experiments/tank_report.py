@@ -22,7 +22,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -36,6 +36,9 @@ from confront.experiments.tanks import (
     share_windows,
 )
 from confront.runs import Run
+
+if TYPE_CHECKING:
+    from confront.engine.tank_export import Play
 
 # the issue's targets per kind of entry: (share, what)
 TARGETS = {"1v1": 0.90, "4v4": 0.80, "4v4:td": 0.75, "4v4:dodge": 0.65}
@@ -119,7 +122,7 @@ def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int, cfg
     return float(got[key])
 
 
-def sim_shares(run: Path, cfg: Any, rounds: int, play: str = "greedy") -> dict[str, float]:
+def sim_shares(run: Path, cfg: Any, rounds: int, play: Play = "greedy") -> dict[str, float]:
     """The run's simulator share per league entry over ``rounds`` rounds (battle seed 10000), playing greedy
     or sampled, kept in ``<run>/eval/<play>-<rounds>.json`` (a model is evaluated once, whichever report
     asks)."""
@@ -138,7 +141,7 @@ def sim_shares(run: Path, cfg: Any, rounds: int, play: str = "greedy") -> dict[s
 
 def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int, unseen: bool = False,
            compare_work: Path | None = None, engine_from: Path | None = None, engine_runs: int = 1,
-           play: str = "greedy") -> dict[str, Any]:
+           play: Play = "greedy") -> dict[str, Any]:
     """Evaluate the runs and write the report; return the results (``unseen``: also the first run's exported
     robot in the engine against :data:`UNSEEN`, robots no league entry names; ``compare_work``: also the
     comparison with the baselines, :mod:`confront.experiments.tank_compare`, trained and cached there;

@@ -24,19 +24,23 @@ import math
 import time
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
 
 from confront import checkpoint as ck
 from confront.arena.observe import N_DIST_BINS, N_HEADING_BINS, N_STATES, ObservationConfig
-from confront.arena.pool import PoolEntry, PoolEnv, PoolStep
+from confront.arena.pool import OpponentPolicy, PoolEntry, PoolEnv, PoolStep
 from confront.arena.smdp import SMDPConfig
 from confront.arena.tank import FEATURE_NAMES, OWN_FEATURES, TankSpace
 from confront.experiments.spec import ExperimentConfig
 from confront.learning.ppo import PPO, UPDATE_STATS, PPOConfig, Rollout
 from confront.runs import Run
+
+if TYPE_CHECKING:
+    from confront.engine.export import ExportedPolicy
+    from confront.learning.base import Learner
 
 __all__ = ["TankTrainer", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
            "PAPER_MOVE_OPPONENTS", "paper_move_values", "paper_move_robot",
@@ -99,7 +103,7 @@ def paper_move_values(cfg: ExperimentConfig, opp: str, progress: bool = False) -
     return q
 
 
-def paper_move_robot(cfg: ExperimentConfig, opp: str):  # noqa: ANN201 - an ExportedPolicy (engine import kept lazy)
+def paper_move_robot(cfg: ExperimentConfig, opp: str) -> ExportedPolicy:  # the engine import kept lazy
     """A paper-move opponent as the exported ``confront.PolicyBot`` plays it in the engine: its move values with
     random ties, the league's decision interval, the paper's controller and scan memory, as in the simulator."""
     from confront.engine.export import ExportedPolicy
@@ -108,7 +112,7 @@ def paper_move_robot(cfg: ExperimentConfig, opp: str):  # noqa: ANN201 - an Expo
                           step_turns=cfg.tank.decision_turns, ties="random")
 
 
-def strafe_policy(space: TankSpace):  # noqa: ANN201 - returns an OpponentPolicy
+def strafe_policy(space: TankSpace) -> OpponentPolicy:
     """A hand-written stochastic strafer in the tank actions, with the learners' own gun: the body perpendicular
     to the nearest known enemy, full distance on in the direction it moves (reversed with probability 0.2 each
     step), fire power 1 with the last lead of ``space.leads``."""
@@ -194,14 +198,14 @@ def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, pro
     return PoolEnv(entries, smdp_tank_config(cfg), seed=seed), snap
 
 
-def _td_learner(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - a TabularQ
+def _td_learner(cfg: ExperimentConfig, progress: bool) -> Learner:
     """The paper's TD team's learner (trained once per seed and cached, as in the paper's experiments)."""
     from confront.experiments.episodes import td_team
 
     return td_team(cfg, 4, progress=progress)[0]
 
 
-def _td_opponent(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - returns an OpponentPolicy
+def _td_opponent(cfg: ExperimentConfig, progress: bool) -> OpponentPolicy:
     """The paper's TD team, greedy (random ties)."""
     learner = _td_learner(cfg, progress)
 
@@ -213,14 +217,6 @@ def _td_opponent(cfg: ExperimentConfig, progress: bool):  # noqa: ANN202 - retur
 
 # -- models ------------------------------------------------------------------------------------------------------
 
-def _write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
-    """Arrays as an uncompressed .npz, written atomically (data only)."""
-    import io
-
-    buf = io.BytesIO()
-    np.savez(buf, **arrays)
-    ck.write_atomic(path, buf.getvalue())
-
 
 def _read_npz(path: Path) -> dict[str, np.ndarray]:
     with np.load(path, allow_pickle=False) as z:
@@ -231,8 +227,8 @@ def save_tank_model(folder: Path, ppo: PPO, cfg: ExperimentConfig, meta: dict[st
     """``model.json`` (kind ppo), ``actor.npz`` (w0, b0, ... as (out, in)), ``tank.json`` (actions, view,
     controller), ``ppo.npz`` (the whole learner, to continue training)."""
     folder.mkdir(parents=True, exist_ok=True)
-    _write_npz(folder / "actor.npz", ppo.actor_arrays())
-    _write_npz(folder / "ppo.npz", ppo.state_dict())
+    ck.write_npz(folder / "actor.npz", ppo.actor_arrays())
+    ck.write_npz(folder / "ppo.npz", ppo.state_dict())
     from confront.arena.control import ControlConfig
 
     c = ControlConfig()
@@ -458,9 +454,10 @@ def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_
         joint, *_ = ppo.act(obs, explore=explore)
         st = pool.step(joint)
         for r in st.rounds:
-            if done[r["opponent"]] < rounds:
+            name = str(r["opponent"])
+            if done[name] < rounds:
                 rows.append(r)
-                done[r["opponent"]] += 1
+                done[name] += 1
         obs = st.obs
     shares = share_by_opponent(rows)
     return {k: {"share": shares[k], "win_rate": float(np.mean([r["won"] for r in rows if r["opponent"] == k])),

@@ -358,10 +358,10 @@ class EngineTankTrainer:
         order = sorted(range(n), key=lambda i: (kept[i].round, kept[i].turn, kept[i].robot))
         key = [(kept[i].round, kept[i].turn) for i in order]
         group = np.cumsum([0] + [int(a != b) for a, b in zip(key, key[1:], strict=False)])
-        alive = obs[order, FEATURE_NAMES.index("energy")] > 0
+        living = obs[order, FEATURE_NAMES.index("energy")] > 0
         crit = np.zeros((n, 2 * obs.shape[1] if self.ppo.config.team_critic else obs.shape[1]), np.float32)
         if n:
-            crit[order] = self.ppo.critic_input(obs[order], group, int(group[-1]) + 1, alive)
+            crit[order] = self.ppo.critic_input(obs[order], group, int(group[-1]) + 1, living)
         logp = self.ppo.log_prob(obs, heads) if n else np.zeros(0, np.float32)
         value = self.ppo.values(crit, threads=self.ppo.config.threads) if n else np.zeros(0, np.float32)
         reward = np.concatenate(rewards) * self.ppo.config.reward_scale if rewards else np.zeros(0)

@@ -63,8 +63,14 @@ class Trainer(Protocol):
     desc: str  # progress-bar label
     bar_scalars: dict[str, str]  # scalar name -> progress-bar label
     final_window: int  # rounds the summary's final score ratio pools
-    rows: list[dict[str, Any]]  # one per round, in the order rounds ended
-    decisions: int
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        """One per round, in the order rounds ended."""
+        ...
+
+    @property
+    def decisions(self) -> int: ...
 
     @property
     def rounds_done(self) -> int: ...

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from confront.checkpoint import write_npz
 from confront.learning.base import Learner, params_from_dict
 from confront.learning.dmnn import DMNN, DMNNParams
 from confront.learning.fuzzy import FuzzyParams
@@ -82,7 +83,7 @@ def transfer_from(source: Learner, params: TransferParams | None = None, warm_st
 
 
 def save_learner(path: str | Path, learner: Learner) -> Path:
-    """Write kind, parameters (JSON text) and state arrays to one ``.npz`` (no pickled objects)."""
+    """Write kind, parameters (JSON text) and state arrays to one ``.npz`` (no pickled objects), atomically."""
     frozen = isinstance(learner, Frozen)
     inner = learner.inner if isinstance(learner, Frozen) else learner
     if isinstance(inner, TransferPolicy):
@@ -93,9 +94,7 @@ def save_learner(path: str | Path, learner: Learner) -> Path:
     if "__meta__" in state:
         raise ValueError("state key '__meta__' is reserved")
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with open(out, "wb") as fh:
-        np.savez(fh, __meta__=np.array(meta), **state)
+    write_npz(out, {"__meta__": np.array(meta), **state})
     return out
 
 

@@ -123,13 +123,13 @@ class _TanhFn(torch.autograd.Function):
     sigmoid's: 22% of an update's time); the backward is tanh's, (1 - y^2) g."""
 
     @staticmethod
-    def forward(ctx: torch.autograd.function.FunctionCtx, x: torch.Tensor) -> torch.Tensor:  # type: ignore[override]
+    def forward(ctx: torch.autograd.function.FunctionCtx, x: torch.Tensor) -> torch.Tensor:
         y = torch.sigmoid(2.0 * x).mul_(2.0).sub_(1.0)
         ctx.save_for_backward(y)
         return y
 
     @staticmethod
-    def backward(ctx: torch.autograd.function.FunctionCtx, g: torch.Tensor) -> torch.Tensor:  # type: ignore[override]
+    def backward(ctx: torch.autograd.function.FunctionCtx, g: torch.Tensor) -> torch.Tensor:
         (y,) = ctx.saved_tensors  # type: ignore[attr-defined]
         return torch.ops.aten.tanh_backward(g, y)
 
@@ -152,6 +152,9 @@ def _layer(n_in: int, n_out: int, gain: float) -> nn.Linear:
 class ActorCritic(nn.Module):
     """Actor: F -> H -> H -> sum(dims) logits (tanh); critic: (F or 2F) -> Hc -> Hc -> 1 (tanh), Hc =
     ``critic_hidden`` or H."""
+
+    pad_index: torch.Tensor  # buffers (register_buffer below)
+    pad: torch.Tensor
 
     def __init__(self, n_features: int, dims: tuple[int, ...], hidden: int, team_critic: bool,
                  critic_hidden: int = 0) -> None:

@@ -37,7 +37,7 @@ class UniformPolicy(Learner):
 
     def act(self, obs: np.ndarray, rng: np.random.Generator, explore: bool = True) -> np.ndarray:
         n = np.asarray(obs).shape[0]
-        return rng.integers(0, self.n_actions, size=n).astype(np.int64)
+        return np.asarray(rng.integers(0, self.n_actions, size=n), dtype=np.int64)
 
     def learn(self, batch: Transition) -> dict[str, float]:
         return {}

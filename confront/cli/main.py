@@ -58,6 +58,10 @@ def _engine_errors() -> tuple[type[BaseException], ...]:
     return (EngineNotFoundError,)
 
 
+WATCH = click.option("--watch", is_flag=True, help="With --engine robocode: show the battles in Robocode's own window "
+                     "as they play, at its display speed (needs a display).")
+
+
 def set_option(f: Callable[..., Any]) -> Callable[..., Any]:
     return click.option(
         "--set", "overrides", multiple=True, metavar="KEY=VALUE",
@@ -136,11 +140,15 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
 @click.option("--play", type=click.Choice(["sampled", "greedy"]), default=None,
               help="PPO tanks: sample each action head (the default, as `confront export` plays) or take its "
               "maximum. Paper policies always play greedily.")
-def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: int, play: str | None) -> None:
+@WATCH
+def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: int, play: str | None,
+             watch: bool) -> None:
     """Play a trained policy (simulator or real engine) and print its score table."""
+    from confront.engine.tank_export import Play
     from confront.experiments.evaluate import evaluate_cli
 
-    evaluate_cli(run, engine=engine, opponents=opponents, rounds=rounds, seed=seed, play=play)
+    evaluate_cli(run, engine=engine, opponents=opponents, rounds=rounds, seed=seed, play=cast(Play | None, play),
+                 watch=watch)
 
 
 @cli.command()
@@ -183,13 +191,14 @@ def sweep(grid: Path, out: Path, address: str | None, seeds: int | None) -> None
 @click.option("--replay", "replay_out", type=click.Path(path_type=Path), default=None,
               help="Also record the first round to this replay file (.json or .json.gz, plus .gif and .html; "
                    "simulator only).")
+@WATCH
 def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: int, battles: int,
-           replay_out: Path | None) -> None:
+           replay_out: Path | None, watch: bool) -> None:
     """Run a battle of scripted robots in the simulator or the real engine and print Robocode's score table."""
     from confront.experiments.evaluate import battle_cli
 
     battle_cli(scenario=scenario, robots=robots, engine=engine, rounds=rounds, seed=seed, replay_out=replay_out,
-               battles=battles)
+               battles=battles, watch=watch)
 
 
 @cli.command()

@@ -37,6 +37,7 @@ def evaluate_policy(
     mode: str = "export",
     cpu_constant_ms: float | None = None,
     opponent_policy: ExportedPolicy | None = None,
+    visible: bool = False,
 ) -> tuple[BattleResults, float]:
     """Play ``policy`` for our side of ``scenario`` and return (results, our score ratio); with
     ``opponent_policy`` (export mode only) against that policy exported as PolicyBot too (e.g. the TD team).
@@ -45,14 +46,14 @@ def evaluate_policy(
     twin pick the move every ``policy.step_turns`` turns through the bridge, with the gun/radar controller run
     by the robot in Java (the exported robot's code) every turn. Both decide identically on identical
     observations. ``cpu_constant_ms`` defaults to ``BRIDGE_CPU_CONSTANT_MS`` (100 ms, fewer skipped turns)
-    for the bridge and 10 ms for the export.
+    for the bridge and 10 ms for the export. ``visible``: in Robocode's battle window (``EngineOptions.visible``).
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}, got {mode!r}")
     if opponent_policy is not None and mode != "export":
         raise ValueError("an opponent policy plays in export mode only")
     cpu = cpu_constant_ms or (BRIDGE_CPU_CONSTANT_MS if mode == "bridge" else 10.0)
-    opts = EngineOptions(seed=seed, cpu_constant_ms=cpu)
+    opts = EngineOptions(seed=seed, cpu_constant_ms=cpu, visible=visible)
     name = "confront."  # our robot's name in 1v1 (its contestants: ours and sample robots)
     if mode == "bridge":
         spec = scenario_battle(scenario, BRIDGE_BOT.rstrip("*"), opponents, rounds=rounds)

@@ -14,8 +14,9 @@ _DEFAULT_JAR = Path("/usr/share/java/robocode.jar")
 _DEFAULT_SAMPLES = Path("/usr/share/games/robocode/robots")
 
 # JVM flags the engine needs under Java 17 (robocode-facts.md, section 0).
+HEADLESS = "-Djava.awt.headless=true"  # no display (dropped for a visible battle)
 JVM_FLAGS: tuple[str, ...] = (
-    "-Djava.awt.headless=true",
+    HEADLESS,
     "--add-opens=java.base/sun.net.www.protocol.jar=ALL-UNNAMED",
     "--add-opens=java.base/java.lang.reflect=ALL-UNNAMED",
     "--add-opens=java.desktop/javax.swing.text=ALL-UNNAMED",

@@ -17,12 +17,15 @@ from typing import Any
 
 from confront.engine.affinity import ONE_CPU_JVM_FLAGS, claimed_cpu
 from confront.engine.battle import BattleSpec
-from confront.engine.install import JVM_FLAGS, EngineInstall, find_engine
+from confront.engine.install import HEADLESS, JVM_FLAGS, EngineInstall, find_engine
 from confront.engine.java_build import compile_java
 from confront.engine.workdir import prepare_workdir, write_robot_data
 from confront.results import BattleResults, ScoreRow, parse_results_text
 
 RUNNER_CLASS = "confront.ConfrontRunner"
+
+
+VISIBLE_TIMEOUT_S = 86400.0  # a visible battle plays at display speed while somebody watches
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,9 @@ class EngineOptions:
     # faster on the project's machine, but the engine's thread races may then go the other way (docs/engine.md,
     # "One CPU per engine process"), so it is for training in the engine, not for comparisons with the simulator
     one_cpu: bool = False
+    # show Robocode's battle window while the battle runs (needs a display: DISPLAY set, e.g. under xvfb-run);
+    # the window plays at Robocode's display speed (its TPS slider), so the time limit is then at least a day
+    visible: bool = False
 
     def __post_init__(self) -> None:
         if self.seed is not None and not -(2**63) <= self.seed < 2**63:
@@ -79,7 +85,8 @@ def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: Eng
                  one_cpu: bool = False) -> list[str]:
     """The JVM command line for the runner (flags from robocode-facts.md section 0; ``one_cpu``: the process
     will run on one CPU, so it compiles with C1 only)."""
-    cmd = [install.java, f"-Xmx{opts.max_heap_mb}M", f"-DWORKINGDIRECTORY={workdir}", *JVM_FLAGS]
+    flags = [f for f in JVM_FLAGS if f != HEADLESS] + ["-Dconfront.visible=true"] if opts.visible else list(JVM_FLAGS)
+    cmd = [install.java, f"-Xmx{opts.max_heap_mb}M", f"-DWORKINGDIRECTORY={workdir}", *flags]
     if one_cpu:
         cmd += list(ONE_CPU_JVM_FLAGS)
     if opts.seed is not None:
@@ -203,6 +210,9 @@ def run_battle(
     robots folders to add (e.g. an exported robot).
     """
     opts = options or EngineOptions()
+    if opts.visible and not os.environ.get("DISPLAY"):
+        raise ValueError("a visible battle needs a display, and DISPLAY is not set (run it on a desktop, or "
+                         "under xvfb-run)")
     install = install or find_engine()
     classes = compile_java(install)
     with tempfile.TemporaryDirectory(prefix="confront-robocode-") as tmp:
@@ -220,7 +230,10 @@ def run_battle(
         log = run_dir / "engine.log"
         with claimed_cpu(opts.one_cpu) as cpu:
             cmd = java_command(install, classes, wd, opts, one_cpu=cpu is not None) + args
-            code = run_process(cmd, opts.timeout_s, run_dir, log, env=dict(opts.env), cpu=cpu)
+            timeout = max(opts.timeout_s, VISIBLE_TIMEOUT_S) if opts.visible else opts.timeout_s
+            code = run_process(cmd, timeout, run_dir, log, env=dict(opts.env), cpu=cpu)
+        if not summary_file.is_file() and opts.visible:
+            raise RuntimeError(f"the battle window was closed before the battle ended (engine exit {code})")
         if not summary_file.is_file():
             tail = log.read_text(errors="replace")[-2000:]
             raise RuntimeError(f"engine run failed (exit {code}) without a summary:\n{tail}")
@@ -247,16 +260,18 @@ def run_scenario(
     seed: int | None = 0,
     cpu_constant_ms: float = 10.0,
     out_dir: str | os.PathLike[str] | None = None,
+    visible: bool = False,
 ) -> EngineRun:
     """What ``confront battle --engine robocode`` calls: run a named scenario, optionally save the tables.
 
     With ``out_dir``: results.txt (the engine's own file), results.csv / results.md (exact score parts,
-    contestants), robots.csv (per robot) and summary.json (turns, skipped turns, timings).
+    contestants), robots.csv (per robot) and summary.json (turns, skipped turns, timings). ``visible``: in
+    Robocode's battle window (:attr:`EngineOptions.visible`).
     """
     from confront.engine.battle import scenario_battle
 
     spec = scenario_battle(scenario, ours, opponents, rounds=rounds)
-    run = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms))
+    run = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms, visible=visible))
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)

@@ -307,11 +307,12 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
 def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,
                          seed: int = 0, cpu_constant_ms: float = TANK_CPU_CONSTANT_MS,
                          install: EngineInstall | None = None, opponent_policy: ExportedPolicy | None = None,
-                         one_cpu: bool = False) -> tuple[BattleResults, float]:
+                         one_cpu: bool = False, visible: bool = False) -> tuple[BattleResults, float]:
     """Play the exported TankBot (a jar, no Python in the loop) for our side of ``scenario`` (``1v1``,
     ``4v4``, ...) against ``opponents`` in the engine, or with ``opponent_policy`` against that paper policy
     exported as ``confront.PolicyBot`` (e.g. the TD team, the dodge); return (results, our score ratio).
-    ``one_cpu``: the engine process on one CPU, as training in the engine runs it (``EngineOptions.one_cpu``)."""
+    ``one_cpu``: the engine process on one CPU, as training in the engine runs it (``EngineOptions.one_cpu``);
+    ``visible``: in Robocode's battle window (``EngineOptions.visible``)."""
     from confront.engine.battle import scenario_battle, single_star
     from confront.engine.runner import EngineOptions, run_battle
 
@@ -321,7 +322,8 @@ def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Seq
             robots.append(export_robot(opponent_policy, Path(tmp) / "robots", install))
             opponents = "confront.PolicyBot"
         spec = single_star(scenario_battle(scenario, TANK_ROBOT, opponents, rounds=rounds), "confront.PolicyBot*")
-        res = run_battle(spec, EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms, one_cpu=one_cpu),
+        opts = EngineOptions(seed=seed, cpu_constant_ms=cpu_constant_ms, one_cpu=one_cpu, visible=visible)
+        res = run_battle(spec, opts,
                          extra_robots=robots, install=install).results
     # by name: in 1v1 against an exported PolicyBot both robots' names start with "confront."
     ours = next(r for r in res.contestants if r.name.startswith((TANK_ROBOT.split()[0], "confrontteams.Ours")))

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
@@ -18,6 +19,9 @@ from confront.experiments.episodes import Loop, Side, load_model, scenario_of, s
 from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.learning.base import Learner
 from confront.results import BattleResults, ScoreRow
+
+if TYPE_CHECKING:
+    from confront.engine.tank_export import Play
 
 SIM_SEEDS = 5  # simulator seeds per opponent: the simulator is cheap, and their spread shows a ratio's noise
 SIM_BATTLES = 16  # battles side by side in a simulator evaluation
@@ -104,13 +108,14 @@ def sim_ratios(cfg: ExperimentConfig, learner: Learner, opponent: str, rounds: i
 
 
 def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, seed: int,
-                 sim_seeds: int = SIM_SEEDS, play: str | None = None) -> None:
+                 sim_seeds: int = SIM_SEEDS, play: Play | None = None, watch: bool = False) -> None:
     """Score tables of the run's policy per opponent, in the simulator (seed ``seed``, and the range
     over ``sim_seeds`` runs with disjoint battle seeds from ``seed`` on) and with ``engine="robocode"`` in the
-    real engine. ``play``: PPO tanks sample their heads (``"sampled"``, the default) or take the maximum
-    (``"greedy"``); paper policies play greedily and take no ``play``."""
+    real engine (``watch``: in Robocode's battle window). ``play``: PPO tanks sample their heads (``"sampled"``,
+    the default) or take the maximum (``"greedy"``); paper policies play greedily and take no ``play``."""
     if sim_seeds < 1:
         raise ValueError(f"sim_seeds must be >= 1, got {sim_seeds}")
+    _check_watch(watch, engine)
     from confront.engine.tank_export import is_tank_run
 
     if is_tank_run(run):  # PPO tanks: per league entry (the engine: the exported TankBot)
@@ -120,7 +125,7 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
         if engine == "robocode":
             from confront.experiments.tanks import evaluate_tank_engine_cli
 
-            evaluate_tank_engine_cli(run, opponents, rounds, seed, play=play or "sampled")
+            evaluate_tank_engine_cli(run, opponents, rounds, seed, play=play or "sampled", visible=watch)
         return
     if play is not None:
         raise click.UsageError("--play is for PPO tank runs (paper policies play greedily)")
@@ -157,7 +162,7 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
             from confront.engine.evaluate import evaluate_policy
 
             res, ratio = evaluate_policy(exported_policy(learner, cfg), cfg.arena.scenario, name, rounds=rounds,
-                                         seed=seed)
+                                         seed=seed, visible=watch)
             click.echo(f"{name} in Robocode ({rounds} rounds, {res.skipped_turns} skipped turns):\n"
                        f"{res.to_markdown()}")
             real, diff = f"{ratio:.3f}", f"{ratio - sim_ratio:+.3f}"
@@ -223,8 +228,21 @@ def record_bot_round(scenario: str, robots: list[str], seed: int, out: Path) -> 
     return Path(path)
 
 
+def _check_watch(watch: bool, engine: str) -> None:
+    """``--watch`` shows Robocode's own battle window: the real engine only, and a display."""
+    if not watch:
+        return
+    if engine != "robocode":
+        raise click.UsageError("--watch shows Robocode's own battle window: use it with --engine robocode "
+                               "(simulator battles are watched with --replay or confront replay)")
+    if not os.environ.get("DISPLAY"):
+        raise click.UsageError("--watch needs a display, and DISPLAY is not set (run it on a desktop, or under "
+                               "xvfb-run)")
+
+
 def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed: int,
-               replay_out: Path | None, battles: int = 1) -> None:
+               replay_out: Path | None, battles: int = 1, watch: bool = False) -> None:
+    _check_watch(watch, engine)
     sc = scenario_of(scenario)
     from confront.arena.bots import BOT_NAMES
     from confront.arena.scenarios import SAMPLE_TEAMS
@@ -245,7 +263,7 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
             raise click.UsageError("--replay records simulator battles only")
         if len(names) != 2:
             raise click.UsageError("--engine robocode battles take two sides: --robots OURS,THEIRS")
-        run = run_scenario(sc.name, names[0], names[1], rounds=rounds, seed=seed)
+        run = run_scenario(sc.name, names[0], names[1], rounds=rounds, seed=seed, visible=watch)
         click.echo(f"Robocode, {sc.name}, {rounds} rounds ({run.turns} turns, {run.elapsed_s:.1f} s, "
                    f"{sum(run.skipped_turns.values())} skipped turns):\n{run.results.to_markdown()}")
         return

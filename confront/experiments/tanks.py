@@ -40,6 +40,7 @@ from confront.runs import Run
 
 if TYPE_CHECKING:
     from confront.engine.export import ExportedPolicy
+    from confront.engine.tank_export import Play
     from confront.learning.base import Learner
 
 __all__ = ["TankTrainer", "tank_space", "smdp_tank_config", "build_pool", "dodge_policy", "strafe_policy",
@@ -493,7 +494,7 @@ def league_entries(opponents: str | None, cfg: ExperimentConfig) -> tuple[str, .
     return tuple(n if ":" in n else f"1v1:{n}" for n in names)
 
 
-def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int, play: str = "sampled"
+def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int, play: Play = "sampled"
                       ) -> dict[str, dict[str, float]]:
     """Shares of a PPO run per league entry in the simulator, printed as a table; ``play``: ``"sampled"``
     draws each head from its softmax, ``"greedy"`` takes its first maximum."""
@@ -520,17 +521,17 @@ def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int, 
 
 
 def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed: int,
-                             seeds: int = 1, play: str = "sampled") -> dict[str, list[float]]:
+                             seeds: int = 1, play: Play = "sampled", visible: bool = False) -> dict[str, list[float]]:
     """The exported TankBot (a jar, no Python, playing ``play``) in the real engine against each scripted league
     entry, ``seeds`` battles of ``rounds`` rounds (engine seeds ``seed``, ``seed + 1``, ...): our score ratio
-    per battle."""
+    per battle. ``visible``: each battle in Robocode's battle window."""
     from confront.arena.bots import BOT_NAMES
     from confront.arena.scenarios import SAMPLE_TEAMS
     from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
     from confront.experiments.spec import config_from_dict, load_toml
 
     cfg = config_from_dict(load_toml(run / "config.toml"))
-    policy = load_tank_policy(run, play)  # type: ignore[arg-type]  # checked by load_tank_policy
+    policy = load_tank_policy(run, play)
     out: dict[str, list[float]] = {}
     click.echo(f"\n{run}: the exported TankBot ({play}) in Robocode, {rounds} rounds x {seeds} battle(s) per "
                "opponent\n")
@@ -540,6 +541,7 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
         if opp not in BOT_NAMES and opp not in SAMPLE_TEAMS:
             click.echo(f"| {entry} | - | simulator only |")
             continue
-        out[entry] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed + k)[1] for k in range(seeds)]
+        out[entry] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed + k, visible=visible)[1]
+                      for k in range(seeds)]
         click.echo(f"| {entry} | {seeds} | {' / '.join(f'{v:.3f}' for v in out[entry])} |")
     return out

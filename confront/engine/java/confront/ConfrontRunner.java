@@ -120,6 +120,9 @@ public final class ConfrontRunner extends BattleAdaptor {
                     runner.writeHeader(spec, robots, battle);
                 }
                 String positions = battle.getProperty("robocode.battle.initialPositions");
+                if (Boolean.getBoolean("confront.visible")) {
+                    engine.setVisible(true);  // Robocode's own battle window (needs a display)
+                }
                 engine.runBattle(spec, positions, true);
                 if (runner.completed == null && runner.abortedAt < 0) {
                     runner.errors.add("battle did not complete");

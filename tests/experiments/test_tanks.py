@@ -427,3 +427,47 @@ def test_report_curves_come_from_the_first_run_with_round_metrics(tmp_path, caps
     figs = _curves([shipped, trained], tmp_path / "b")
     assert [f.name for f in figs] == ["share_vs_decisions.png", "share_vs_wall_s.png"]
     assert all(f.stat().st_size > 1000 for f in figs)
+
+
+def test_report_end_to_end_from_a_trained_run(tmp_path) -> None:
+    """tank_report.report on a real (tiny) run: the simulator shares are evaluate_tanks' at battle seed 10000 and
+    cached per play, the engine rows come from an earlier results.json of the same run only, and report.md and
+    the curves are written; the command line refuses bad arguments with one line."""
+    import subprocess
+    import sys
+
+    from confront.experiments.tank_report import report
+    from confront.experiments.tanks import load_tank_model
+
+    cfg = _cfg(tmp_path, "1v1:SittingDuck,1v1:SpinBot", **{"league.battles": "2", "train.rounds": "12"})
+    run = tmp_path / "run"
+    train_run(cfg, run, progress=False)
+    earlier = tmp_path / "earlier.json"
+    earlier.write_text(json.dumps({"runs": ["run"], "engine_seeds": 2, "unseen": [],
+                                   "rows": [{"entry": "1v1:SpinBot", "engine": [0.81, 0.83]}]}))
+    res = report([run], tmp_path / "out", rounds=4, engine=False, engine_seeds=1, engine_from=earlier,
+                 play="sampled")
+    want = evaluate_tanks(cfg, load_tank_model(run, cfg), 4, seed=10_000, explore=True)
+    rows = {r["entry"]: r for r in res["rows"]}
+    assert set(rows) == {"1v1:SittingDuck", "1v1:SpinBot"}
+    for e, r in rows.items():
+        assert r["sim"] == [want[e]["share"]]
+    assert rows["1v1:SpinBot"]["engine"] == [0.81, 0.83] and rows["1v1:SittingDuck"]["engine"] is None
+    assert res["engine_seeds"] == 2 and res["trained"][0]["rounds"] >= 12
+    assert json.loads((run / "eval" / "sampled-4.json").read_text()) == {e: r["sim"][0] for e, r in rows.items()}
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert "| 1v1:SpinBot |" in md and "0.810 / 0.830" in md
+    assert {p.name for p in (tmp_path / "out").glob("share_vs_*.png")} == {"share_vs_decisions.png",
+                                                                           "share_vs_wall_s.png"}
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({"runs": ["elsewhere"], "engine_seeds": 1, "rows": []}))
+    with pytest.raises(ValueError, match="is of run elsewhere, not run"):
+        report([run], tmp_path / "out2", rounds=4, engine=False, engine_seeds=1, engine_from=other)
+    cli = [sys.executable, "-m", "confront.experiments.tank_report", str(run), "--out", str(tmp_path / "o3")]
+    bad = subprocess.run([*cli, "--engine", "--engine-from", str(earlier)], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--engine plays the battles, --engine-from reads them" in bad.stderr
+    bad = subprocess.run([*cli, "--rounds", "0"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--rounds and --engine-seeds must be at least 1" in bad.stderr
+    bad = subprocess.run([sys.executable, "-m", "confront.experiments.tank_report", str(tmp_path), "--out",
+                          str(tmp_path / "o4")], capture_output=True, text=True)
+    assert bad.returncode == 2 and "is not a trained run folder" in bad.stderr

@@ -102,6 +102,7 @@ class LearnerPolicy:
         self._tanks: dict[tuple[str, int], _Tank] = {}
         self.updates = 0
         self.decisions = 0
+        self.lost_ends = 0  # steps closed without the robot's end line (at its next round, or by end_all)
         self.reward_turns = 0
         self.reward_sum = 0.0
         self.reward_max = -math.inf
@@ -187,8 +188,15 @@ class LearnerPolicy:
 
     def __call__(self, obs: Observation) -> tuple[float, float, float, float, float]:
         """A decision turn: learn the step that ends here, pick the next move; gun, radar, fire are NaN (the
-        robot's controller aims)."""
-        tank = self._tanks.setdefault((obs.robot, obs.round), _Tank())
+        robot's controller aims). A robot's first decision of a round closes any step it left open in an earlier
+        round (the engine can stop a dying robot's thread before its end line goes out): the step's reward turns
+        would have come with that line, so it is dropped unlearned and counted in ``lost_ends``."""
+        key = (obs.robot, obs.round)
+        if key not in self._tanks:
+            for robot, round_ in [k for k in self._tanks if k[0] == obs.robot and k[1] < obs.round]:
+                self.lost_ends += self._tanks[(robot, round_)].obs is not None
+                self.end_episode(robot, round_)
+        tank = self._tanks.setdefault(key, _Tank())
         if tank.obs is not None and not obs.history:
             raise ValueError(f"no energy history in {obs.robot}'s observation of turn {obs.turn}: "
                              "run the bridge with history=True (LearnerPolicy.bridge_kwargs())")
@@ -212,6 +220,8 @@ class LearnerPolicy:
             self._learn(tank, tank.obs, done=True)
 
     def end_all(self) -> None:
-        """Learn every step still open as terminal (a battle ended without a tank's end message)."""
+        """Close every step still open (a battle ended without a tank's end message): learned as terminal if it
+        has reward turns, else dropped; each counts in ``lost_ends``."""
         for robot, round_ in list(self._tanks):
+            self.lost_ends += self._tanks[(robot, round_)].obs is not None
             self.end_episode(robot, round_)

@@ -226,7 +226,7 @@ class EngineTrainer:
                 "skipped_turns": self.skipped_turns, "bridge_failures": self.failures, "bridge_errors": self.errors,
                 "rtt_sum_us": self.rtt_sum_us, "rtt_battles": self.rtt_battles, "setup_s": self.engine_setup_s,
                 "rng": ck.rng_state(self.policy.rng), "decisions": self.policy.decisions,
-                "updates": self.policy.updates}
+                "updates": self.policy.updates, "lost_end_lines": self.policy.lost_ends}
         return arrays, meta
 
     def load(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None:
@@ -235,6 +235,7 @@ class EngineTrainer:
                                          if k.startswith("learner.")})
             self.policy.rng = ck.rng_from_state(meta["rng"])
             self.policy.decisions, self.policy.updates = int(meta["decisions"]), int(meta["updates"])
+            self.policy.lost_ends = int(meta.get("lost_end_lines", 0))  # not in checkpoints before 2026-12-04
             self.rows, self.battles = list(meta["rows"]), int(meta["battles"])
             self.skipped_turns, self.rtt_battles = int(meta["skipped_turns"]), int(meta["rtt_battles"])
             self.failures, self.errors = list(meta["bridge_failures"]), list(meta["bridge_errors"])
@@ -244,7 +245,8 @@ class EngineTrainer:
 
     def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
         """The model and figures; the summary keys (train_run's plus the engine's skipped turns, bridge
-        failures and errors, round trips and the engine's own setup time)."""
+        failures and errors, round trips, the engine's own setup time, and the SMDP steps closed without the
+        robot's end line)."""
         from confront.experiments.plots import session_plots
 
         cfg = self.cfg
@@ -258,7 +260,7 @@ class EngineTrainer:
                 "cpu_constant_ms": self.cpu_constant_ms, "updates": self.policy.updates,
                 "skipped_turns": self.skipped_turns, "bridge_failures": self.failures, "bridge_errors": self.errors,
                 "rtt_mean_us": self.rtt_sum_us / self.rtt_battles if self.rtt_battles else None,
-                "engine_setup_s": self.engine_setup_s}
+                "engine_setup_s": self.engine_setup_s, "lost_end_lines": self.policy.lost_ends}
 
     def close(self) -> None:
         self._tmp.cleanup()

@@ -233,3 +233,26 @@ def test_learners_without_a_q_table_are_decided_in_python() -> None:
     assert pol.robot_acting() is None and pol.bridge_kwargs()["acting"] is None
     move = pol(_obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),)))
     assert _action(move) in range(4) and pol.decisions == 1
+
+
+def test_a_lost_end_line_drops_the_step_at_the_robots_next_round_and_is_counted() -> None:
+    """The engine can stop a dying robot before its end line goes out. Its open step has no reward turn (they
+    come with the next message), so it cannot be learned: it is dropped at the robot's first decision of the next
+    round (or by end_all after the battle), leaves the table as it was, and is counted."""
+    learner = TabularQ()
+    pol = LearnerPolicy(learner, np.random.default_rng(0), step_turns=2, acting=False)
+    pol(_obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),)))
+    pol(_obs(3, 97.0, 84.0, (TurnEnergy(1, 97.0, "e", 100.0, 100.0), TurnEnergy(2, 97.0, "e", 100.0, 84.0)),
+             ex=100.0))
+    assert pol.updates == 1 and set(pol._tanks) == {("me", 0)}
+    q = learner.q.copy()
+    pol(_obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),), round_=1))  # no end line for round 0
+    assert pol.lost_ends == 1 and set(pol._tanks) == {("me", 1)} and pol.updates == 1
+    np.testing.assert_array_equal(learner.q, q)
+    other = replace(_obs(1, 100.0, 100.0, (TurnEnergy(0, 100.0, "", 0.0, 0.0),), round_=2), robot="mate")
+    pol(other)  # another robot's later round leaves this robot's step alone
+    assert set(pol._tanks) == {("me", 1), ("mate", 2)} and pol.lost_ends == 1
+    pol.end_episode("me", 1, (TurnEnergy(2, 99.0, "e", 100.0, 100.0),))  # an end line that came: not counted
+    assert pol.lost_ends == 1 and pol.updates == 2
+    pol.end_all()  # the battle ended with the mate's step open: dropped and counted
+    assert pol.lost_ends == 2 and not pol._tanks

@@ -233,7 +233,7 @@ def run_battle(
             timeout = max(opts.timeout_s, VISIBLE_TIMEOUT_S) if opts.visible else opts.timeout_s
             code = run_process(cmd, timeout, run_dir, log, env=dict(opts.env), cpu=cpu)
         if not summary_file.is_file() and opts.visible:
-            raise RuntimeError(f"the battle window was closed before the battle ended (engine exit {code})")
+            raise RuntimeError(f"the engine exited (code {code}) before the battle ended: was its window closed?")
         if not summary_file.is_file():
             tail = log.read_text(errors="replace")[-2000:]
             raise RuntimeError(f"engine run failed (exit {code}) without a summary:\n{tail}")

@@ -34,6 +34,7 @@ from confront.engine.java_build import compile_java
 
 ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
 POLICY_CLASSES = ("PolicyBot", "PolicyModel", "RoundStart")
+TEAM_SIZE = 4  # the exported team: our side in every team scenario (4v4, 4v6, 4v10)
 
 
 @dataclass(frozen=True)
@@ -281,19 +282,23 @@ def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall
     """Write the standalone robot ``confront.PolicyBot`` with ``policy``: a robots folder or a ``.jar``.
 
     A folder gets ``confront/PolicyBot.class``, ``PolicyModel.class``, ``PolicyData.class`` (the policy
-    compiled in as string constants, so the robot reads no file), ``PolicyBot.properties``, ``policy.txt``
-    and the Java sources; a jar holds the same files and can be dropped into Robocode's robots folder.
+    compiled in as string constants, so the robot reads no file), ``PolicyBot.properties``, ``policy.txt``,
+    the team ``PolicyTeam.team`` (four PolicyBots, the paper's team size) and the Java sources; a jar holds the same
+    files and can be dropped into Robocode's robots folder.
     """
     return write_robot(out, "PolicyBot", POLICY_CLASSES, "PolicyData", "policy.txt", policy.to_text(),
-                       "A policy trained with confront (fuzzy RL), exported with its own inference", install, version)
+                       "A policy trained with confront (fuzzy RL), exported with its own inference", install, version,
+                       team="PolicyTeam")
 
 
 def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str | None, policy_file: str, text: str,
-                description: str, install: EngineInstall | None = None, version: str = "1.0") -> Path:
+                description: str, install: EngineInstall | None = None, version: str = "1.0",
+                team: str | None = None) -> Path:
     """A robot ``confront.<bot>`` as a robots folder or a ``.jar``: the project's compiled ``classes`` and their
     sources, ``<bot>.properties``, the policy ``text`` as ``policy_file`` and compiled into the class ``data``
     (string constants: the robot reads no file, in the engine's sandbox or from a jar; ``None``: no such class,
-    no javac run)."""
+    no javac run). ``team``: also ``confront/<team>.team``, :data:`TEAM_SIZE` of the robot, which Robocode lists
+    as the team ``confront.<team> <version>``."""
     install = install or find_engine()
     compiled = compile_java(install)
     out = Path(out)
@@ -310,6 +315,11 @@ def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str |
             f"robot.description={description}\nrobot.java.source.included=true\nrobocode.version=1.9.3.9\n"
         )
         (pkg / policy_file).write_text(text)
+        if team is not None:
+            members = ",".join([f"confront.{bot} {version}"] * TEAM_SIZE)
+            (pkg / f"{team}.team").write_text(
+                f"team.members={members}\nteam.author.name=confront\nteam.version={version}\n"
+                f"team.description={TEAM_SIZE} {bot}s sharing one trained policy\nrobocode.version=1.9.3.9\n")
         if data is not None:
             (pkg / f"{data}.java").write_text(policy_data_source(text, name=data))
             proc = subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-d", str(root),

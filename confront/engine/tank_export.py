@@ -294,14 +294,15 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
                       embed: bool = True) -> Path:
     """Write the standalone robot ``confront.TankBot`` with ``policy``: a robots folder or a ``.jar``.
 
-    It holds ``confront/TankBot.class``, ``TankModel.class``, ``RoundStart.class``, ``TankData.class`` (the
-    policy as string constants, so the robot reads no file), ``TankBot.properties``, ``tank_policy.txt``
-    and the Java sources. ``embed=False`` leaves out TankData (no javac run: engine training): the robot then
-    reads the file the JVM property ``confront.tank.model`` names, else its ``tank_policy.txt``; both need the
-    engine run with ``-DNOSECURITY=true`` (the sandbox refuses robots reading files, their own jar included)."""
+    It holds ``confront/TankBot.class``, ``TankModel.class``, ``RoundStart.class``, ``TankData.class`` (the policy
+    as string constants, so the robot reads no file), ``TankBot.properties``, ``tank_policy.txt``, the team
+    ``TankTeam.team`` (four TankBots: Robocode lists it as ``confront.TankTeam 1.0``) and the Java sources.
+    ``embed=False`` leaves out TankData (no javac run: engine training): the robot then reads the file the JVM
+    property ``confront.tank.model`` names, else its ``tank_policy.txt``; both need the engine run with
+    ``-DNOSECURITY=true`` (the sandbox refuses robots reading files, their own jar included)."""
     return write_robot(out, "TankBot", TANK_CLASSES, "TankData" if embed else None, "tank_policy.txt",
                        policy.to_text(), "A tank policy trained with confront (PPO), exported with its own inference",
-                       install)
+                       install, team="TankTeam")
 
 
 def evaluate_tank_policy(policy: TankPolicy, scenario: str, opponents: str | Sequence[str], rounds: int = 100,
@@ -369,6 +370,6 @@ def export_tank_cli(run: str | Path, out: str | Path, play: Play = "sampled") ->
     import click
 
     path = export_tank_robot(load_tank_policy(run, play), out)
-    click.echo(f"wrote the robot confront.TankBot to {path}: copy it into Robocode's robots folder "
-               "(no Python needed to run it)")
+    click.echo(f"wrote the robot confront.TankBot and the team confront.TankTeam (4 TankBots) to {path}: copy it "
+               "into Robocode's robots folder (no Python needed to run it)")
     return path

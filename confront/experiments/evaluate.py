@@ -283,8 +283,8 @@ def export_cli(run: Path, out: Path, name: str | None) -> None:
     cfg = _run_config(run)
     learner, _ = load_model(run)
     folder = export_robot(exported_policy(learner, cfg), out)
-    click.echo(f"wrote the robot confront.PolicyBot to {folder}: copy it into Robocode's robots folder "
-               "(no Python needed to run it)")
+    click.echo(f"wrote the robot confront.PolicyBot and the team confront.PolicyTeam (4 PolicyBots) to {folder}: copy "
+               "it into Robocode's robots folder (no Python needed to run it)")
 
 
 

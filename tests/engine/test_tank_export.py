@@ -615,3 +615,34 @@ def test_second_team_knows_its_mates_like_the_simulator(install, tmp_path) -> No
     d[..., 2:5] = np.abs((eng[:n, :, 2:5] - sim[:n, :, 2:5] + math.pi) % (2 * math.pi) - math.pi)
     bad = np.flatnonzero(d.max(axis=(1, 2)) > 1e-6)
     assert bad.size == 0, f"turn {bad[0] + 1}: engine {eng[bad[0]]}, simulator {sim[bad[0]]}"
+
+
+@pytest.mark.engine
+def test_exported_jar_holds_a_team_robocode_lists_and_plays(install, tmp_path) -> None:
+    """`confront export` puts the team confront.TankTeam (four TankBots) in the jar; Robocode's own command line,
+    with the jar in its robots folder as a user would drop it, plays that team against the sample team."""
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+    from confront.engine.battle import BattleSpec
+    from confront.engine.install import JVM_FLAGS
+    from confront.engine.workdir import prepare_workdir
+    from confront.results import parse_results_text
+
+    _write_run(tmp_path / "run", _policy(6))
+    jar = tmp_path / "MyTank.jar"
+    res = CliRunner().invoke(cli, ["export", str(tmp_path / "run"), "--out", str(jar)])
+    assert res.exit_code == 0 and "the team confront.TankTeam (4 TankBots)" in res.output
+    team = zipfile.ZipFile(jar).read("confront/TankTeam.team").decode()
+    assert "team.members=" + ",".join(["confront.TankBot 1.0"] * 4) + "\n" in team
+    wd = prepare_workdir(tmp_path / "wd", install, compile_java(install), extra_robots=[jar])
+    battle = tmp_path / "team.battle"
+    battle.write_text(BattleSpec(("confront.TankTeam 1.0", "sampleteam.MyFirstTeam"), rounds=1).battle_file())
+    results = tmp_path / "results.txt"
+    subprocess.run([install.java, "-Xmx512M", f"-DWORKINGDIRECTORY={wd}", "-DRANDOMSEED=3", *JVM_FLAGS, "-cp",
+                    str(install.jar), "robocode.Robocode", "-battle", str(battle), "-nodisplay", "-nosound",
+                    "-results", str(results)], check=True, capture_output=True, timeout=300)
+    rows = parse_results_text(results.read_text()).contestants
+    assert sorted(r.name.split(" (")[0] for r in rows) == ["confront.TankTeam 1.0", "sampleteam.MyFirstTeam"]
+    assert sum(r.firsts for r in rows) == 1 and all(r.total >= 0 for r in rows)
+    assert max(r.bullet_dmg for r in rows) > 0  # the battle was fought

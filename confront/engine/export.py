@@ -35,6 +35,8 @@ from confront.engine.java_build import compile_java
 ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
 POLICY_CLASSES = ("PolicyBot", "PolicyModel", "RoundStart")
 TEAM_SIZE = 4  # the exported team: our side in every team scenario (4v4, 4v6, 4v10)
+# where Debian's robocode (its /usr/games/robocode launcher) keeps the robots it lists
+ROBOTS_FOLDER_HINT = "Debian's robocode: ~/.local/share/robocode/1.9.3.9/robots/ after its first start"
 
 
 @dataclass(frozen=True)

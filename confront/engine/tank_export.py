@@ -34,7 +34,7 @@ from confront.arena.control import ControlConfig
 from confront.arena.observe import float_mod
 from confront.arena.rules import java_atan2, java_hypot
 from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
-from confront.engine.export import ExportedPolicy, export_robot, write_robot
+from confront.engine.export import ROBOTS_FOLDER_HINT, ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
 from confront.results import BattleResults
 
@@ -371,5 +371,5 @@ def export_tank_cli(run: str | Path, out: str | Path, play: Play = "sampled") ->
 
     path = export_tank_robot(load_tank_policy(run, play), out)
     click.echo(f"wrote the robot confront.TankBot and the team confront.TankTeam (4 TankBots) to {path}: copy it "
-               "into Robocode's robots folder (no Python needed to run it)")
+               f"into Robocode's robots folder ({ROBOTS_FOLDER_HINT}; no Python needed to run it)")
     return path

@@ -276,7 +276,7 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
 
 
 def export_cli(run: Path, out: Path, name: str | None) -> None:
-    from confront.engine.export import export_robot
+    from confront.engine.export import ROBOTS_FOLDER_HINT, export_robot
 
     if out.exists() and not out.is_dir() and out.suffix != ".jar":
         raise FileExistsError(f"--out {out} is an existing file: give a robots folder or a .jar path")
@@ -284,7 +284,7 @@ def export_cli(run: Path, out: Path, name: str | None) -> None:
     learner, _ = load_model(run)
     folder = export_robot(exported_policy(learner, cfg), out)
     click.echo(f"wrote the robot confront.PolicyBot and the team confront.PolicyTeam (4 PolicyBots) to {folder}: copy "
-               "it into Robocode's robots folder (no Python needed to run it)")
+               f"it into Robocode's robots folder ({ROBOTS_FOLDER_HINT}; no Python needed to run it)")
 
 
 

@@ -202,6 +202,29 @@ def battle(scenario: str, robots: str | None, engine: str, rounds: int, seed: in
 
 
 @cli.command()
+@click.argument("jars", nargs=-1, type=click.Path(path_type=Path, exists=True, dir_okay=False))
+@click.option("--workdir", type=click.Path(path_type=Path, file_okay=False), default=None,
+              help="Robocode's working directory (default: Debian's, ~/.local/share/robocode/1.9.3.9).")
+def robocode(jars: tuple[Path, ...], workdir: Path | None) -> None:
+    """Open Robocode's own program (its window and New Battle dialog) with the Java 17 flags Debian's launcher
+    lacks, after copying robot JARS (from confront export) into its robots folder."""
+    from confront.engine.desktop import open_robocode, robocode_workdir
+    from confront.engine.install import find_engine
+
+    install = find_engine()
+    try:
+        proc = open_robocode(install, list(jars), workdir, wait=False)  # checks the display and the jars first
+    except ValueError as err:
+        raise click.UsageError(str(err)) from None
+    wd = robocode_workdir(install, workdir)
+    click.echo(f"Robocode (working directory {wd}; {len(jars)} robot jar(s) copied into its robots folder): "
+               "close its window to return")
+    proc.wait()
+    if proc.returncode != 0:
+        raise click.ClickException(f"Robocode exited with code {proc.returncode} (see {wd}/confront-robocode.log)")
+
+
+@cli.command()
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--out", type=click.Path(path_type=Path), required=True, help="Robots folder or .jar to write.")
 @click.option("--play", type=click.Choice(["sampled", "greedy"]), default=None,

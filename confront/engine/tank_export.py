@@ -371,5 +371,6 @@ def export_tank_cli(run: str | Path, out: str | Path, play: Play = "sampled") ->
 
     path = export_tank_robot(load_tank_policy(run, play), out)
     click.echo(f"wrote the robot confront.TankBot and the team confront.TankTeam (4 TankBots) to {path}: copy it "
-               f"into Robocode's robots folder ({ROBOTS_FOLDER_HINT}; no Python needed to run it)")
+               f"into Robocode's robots folder ({ROBOTS_FOLDER_HINT}; no Python needed to run it), or open Robocode "
+               f"with it: confront robocode {path}")
     return path

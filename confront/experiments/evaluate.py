@@ -284,7 +284,8 @@ def export_cli(run: Path, out: Path, name: str | None) -> None:
     learner, _ = load_model(run)
     folder = export_robot(exported_policy(learner, cfg), out)
     click.echo(f"wrote the robot confront.PolicyBot and the team confront.PolicyTeam (4 PolicyBots) to {folder}: copy "
-               f"it into Robocode's robots folder ({ROBOTS_FOLDER_HINT}; no Python needed to run it)")
+               f"it into Robocode's robots folder ({ROBOTS_FOLDER_HINT}; no Python needed to run it)"
+               + (f", or open Robocode with it: confront robocode {folder}" if folder.suffix == ".jar" else ""))
 
 
 

@@ -4,12 +4,8 @@ battle plays, the battle is the headless one, and without a display or the engin
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import subprocess
 import threading
 import time
-from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,31 +16,6 @@ from confront.cli.main import cli
 from confront.engine.battle import scenario_battle
 from confront.engine.install import EngineInstall
 from confront.engine.runner import EngineOptions, run_battle
-
-
-@pytest.fixture
-def display() -> Iterator[str]:
-    """A virtual X display (Xvfb) for the test, or skip when Xvfb is not installed."""
-    xvfb = shutil.which("Xvfb")
-    if xvfb is None:
-        pytest.skip("Xvfb not installed (apt-get install xvfb)")
-    for n in range(90, 120):
-        if os.path.exists(f"/tmp/.X11-unix/X{n}") or os.path.exists(f"/tmp/.X{n}-lock"):
-            continue
-        proc = subprocess.Popen([xvfb, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        for _ in range(50):
-            if os.path.exists(f"/tmp/.X11-unix/X{n}"):
-                break
-            time.sleep(0.1)
-        if proc.poll() is None:
-            try:
-                yield f":{n}"
-            finally:
-                proc.terminate()
-                proc.wait(10)
-            return
-    pytest.skip("no free X display number for Xvfb")
 
 
 def _lit_pixels(display: str) -> int:
@@ -61,6 +32,7 @@ def _turns(trace: Path) -> list[dict]:
     return [ln for ln in lines if ln["type"] == "turn"]
 
 
+@pytest.mark.xdist_group("display")  # one virtual display at a time
 def test_visible_battle_shows_the_window_and_plays_the_headless_battle(install: EngineInstall, display: str,
                                                                         monkeypatch: pytest.MonkeyPatch,
                                                                         tmp_path: Path) -> None:

@@ -1,0 +1,77 @@
+"""`confront robocode`: Robocode's own program on Debian's working directory, started with the Java 17 flags that
+Debian's launcher lacks, so that its robot repository loads the exported jar's robot and team."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from confront.cli.main import cli
+from confront.engine.desktop import open_robocode, robocode_command, robocode_workdir
+from confront.engine.export import ExportedPolicy, export_robot
+from confront.engine.install import EngineInstall
+
+pytestmark = pytest.mark.xdist_group("display")  # one virtual display at a time
+
+
+def test_workdir_is_made_as_debians_launcher_makes_it(install: EngineInstall, tmp_path: Path) -> None:
+    wd = robocode_workdir(install, tmp_path / "rc")
+    assert (wd / "robots" / "sample" / "SpinBot.class").is_file() and (wd / "config").is_dir()
+    assert (wd / "robots" / "sampleteam" / "MyFirstTeam.team").is_file()
+    assert wd.stat().st_mode & 0o777 == 0o700
+    (wd / "robots" / "mine.jar").write_bytes(b"kept")
+    assert robocode_workdir(install, wd) == wd and (wd / "robots" / "mine.jar").read_bytes() == b"kept"
+
+
+def _repository_after(proc, wd: Path, seconds: float = 90.0) -> bytes:  # noqa: ANN001 - a Popen
+    """robots/robot.database once the program has written it (its repository loaded), then stop the program."""
+    db = wd / "robots" / "robot.database"
+    try:
+        for _ in range(int(seconds / 0.5)):
+            if db.is_file() and db.stat().st_size > 0 and proc.poll() is None:
+                time.sleep(1.0)  # let it finish writing
+                return db.read_bytes()
+            if proc.poll() is not None:
+                break
+            time.sleep(0.5)
+        return db.read_bytes() if db.is_file() else b""
+    finally:
+        proc.terminate()
+        proc.wait(30)
+
+
+def test_robocode_lists_the_exported_team_with_our_flags_and_not_with_debians(
+        install: EngineInstall, display: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    jar = export_robot(ExportedPolicy("qtable", q=np.zeros((320, 4))), tmp_path / "Paper.jar")
+    monkeypatch.setenv("DISPLAY", display)
+    ours = tmp_path / "ours"
+    db = _repository_after(open_robocode(install, [jar], ours, wait=False), ours)
+    assert b"confront.PolicyTeam" in db and b"confront.PolicyBot" in db and b"sample.SpinBot" in db
+    assert b"InaccessibleObjectException" not in (ours / "confront-robocode.log").read_bytes()
+    # Debian's launcher: the same program without --add-opens lists no robot at all
+    debian = robocode_workdir(install, tmp_path / "debian")
+    (debian / "robots" / jar.name).write_bytes(jar.read_bytes())
+    cmd = [c for c in robocode_command(install, debian) if not c.startswith("--add-opens")]
+    import subprocess
+
+    with open(debian / "log.txt", "wb") as log:
+        proc = subprocess.Popen(cmd, cwd=debian, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    db = _repository_after(proc, debian, seconds=20.0)
+    assert b"confront.PolicyTeam" not in db
+    assert b"InaccessibleObjectException" in (debian / "log.txt").read_bytes()
+
+
+def test_robocode_command_refuses_without_a_display_or_a_jar(monkeypatch: pytest.MonkeyPatch,
+                                                            tmp_path: Path) -> None:
+    monkeypatch.delenv("DISPLAY", raising=False)
+    res = CliRunner().invoke(cli, ["robocode", "--workdir", str(tmp_path / "wd")])
+    assert res.exit_code == 2 and "Robocode's window needs a display, and DISPLAY is not set" in res.output
+    assert not (tmp_path / "wd").exists()  # nothing made before the check
+    monkeypatch.setenv("DISPLAY", ":12345")
+    (tmp_path / "policy.txt").write_text("not a jar")
+    res = CliRunner().invoke(cli, ["robocode", str(tmp_path / "policy.txt"), "--workdir", str(tmp_path / "wd")])
+    assert res.exit_code == 2 and "is not a robot jar: write one with confront export RUN --out NAME.jar" in res.output

@@ -48,7 +48,7 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
         f"  tensorboard --logdir {out}/tb             shares per opponent, losses, entropy, decisions/s\n"
         f"  confront evaluate {out} --rounds 100      play the trained team per opponent (score table)\n"
         f"  confront export {out} --out MyTank.jar    a Robocode robot that runs the policy without Python\n"
-        "  confront robocode MyTank.jar               Robocode's own program with it (pick confront.TankTeam 1.0)\n"
+        f"  confront robocode {out}                   Robocode's own program with it (pick confront.TankTeam 1.0)\n"
         f"  confront evaluate {out} --engine robocode --watch --opponents 1v1:SpinBot --rounds 3\n"
         "                                             watch it in Robocode's own window (apt-get install robocode)\n"
         "  confront train -c tanks                    the whole league (every sample robot, 1v1 and teams)\n"

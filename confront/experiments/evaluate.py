@@ -275,6 +275,21 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
         click.echo(f"replay of the first round: {path} (and .gif, .html beside it)")
 
 
+def run_jar(run: Path, folder: Path, play: Play = "sampled") -> Path:
+    """A trained run's robot as a jar in ``folder``: ``confront-TankBot.jar`` for PPO tanks (playing ``play``),
+    ``confront-PolicyBot.jar`` for the paper's policies; always the same name per robot, so that a newer export
+    replaces an older one in a robots folder (both would hold the same robot class)."""
+    from confront.engine.export import export_robot
+    from confront.engine.tank_export import export_tank_robot, is_tank_run, load_tank_policy
+
+    if is_tank_run(run):
+        return export_tank_robot(load_tank_policy(run, play), Path(folder) / "confront-TankBot.jar")
+    if not (run / "config.toml").is_file():
+        raise FileNotFoundError(f"{run} is not a trained run folder (no config.toml): give a run or a robot jar")
+    learner, _ = load_model(run)
+    return export_robot(exported_policy(learner, _run_config(run)), Path(folder) / "confront-PolicyBot.jar")
+
+
 def export_cli(run: Path, out: Path, name: str | None) -> None:
     from confront.engine.export import ROBOTS_FOLDER_HINT, export_robot
 

@@ -646,3 +646,19 @@ def test_exported_jar_holds_a_team_robocode_lists_and_plays(install, tmp_path) -
     assert sorted(r.name.split(" (")[0] for r in rows) == ["confront.TankTeam 1.0", "sampleteam.MyFirstTeam"]
     assert sum(r.firsts for r in rows) == 1 and all(r.total >= 0 for r in rows)
     assert max(r.bullet_dmg for r in rows) > 0  # the battle was fought
+
+
+@pytest.mark.engine
+def test_run_jar_exports_a_run_under_its_robots_fixed_name(install, tmp_path) -> None:
+    """`confront robocode RUN`: the run becomes confront-TankBot.jar (robot and team), one name per robot class."""
+    from confront.experiments.evaluate import run_jar
+
+    _write_run(tmp_path / "run", _policy(6))
+    jar = run_jar(tmp_path / "run", tmp_path / "robots")
+    assert jar == tmp_path / "robots" / "confront-TankBot.jar"
+    names = set(zipfile.ZipFile(jar).namelist())
+    assert {"confront/TankBot.class", "confront/TankData.class", "confront/TankTeam.team"} <= names
+    assert "play sampled" in zipfile.ZipFile(jar).read("confront/tank_policy.txt").decode()
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(FileNotFoundError, match="is not a trained run folder"):
+        run_jar(tmp_path / "empty", tmp_path / "robots")

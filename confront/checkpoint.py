@@ -100,16 +100,12 @@ def write_atomic(path: Path, data: bytes) -> None:
         raise
 
 
-def npz_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
-    """``arrays`` as the bytes of an uncompressed .npz (data only: it loads with ``allow_pickle=False``)."""
+def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
+    """``arrays`` as an uncompressed .npz at ``path`` (data only: it loads with ``allow_pickle=False``), written
+    atomically (:func:`write_atomic`)."""
     buf = io.BytesIO()
     _savez(buf, arrays)
-    return buf.getvalue()
-
-
-def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
-    """``arrays`` as an uncompressed .npz at ``path``, written atomically (:func:`write_atomic`)."""
-    write_atomic(path, npz_bytes(arrays))
+    write_atomic(path, buf.getvalue())
 
 
 def _savez(fh: IO[bytes], arrays: Mapping[str, np.ndarray]) -> None:

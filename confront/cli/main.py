@@ -209,25 +209,21 @@ def robocode(robots: tuple[Path, ...], workdir: Path | None) -> None:
     """Open Robocode's own program (its window and New Battle dialog) with the Java 17 flags Debian's launcher
     lacks, after copying ROBOTS into its robots folder: robot jars (confront export), or trained run folders
     (exported here as confront-TankBot.jar / confront-PolicyBot.jar)."""
-    import os
     import tempfile
 
     from confront.engine.desktop import open_robocode, robocode_workdir
-    from confront.engine.install import find_engine
+    from confront.engine.install import find_engine, require_display
     from confront.experiments.evaluate import run_jar
 
     install = find_engine()
-    if not os.environ.get("DISPLAY"):  # before exporting anything
-        raise click.UsageError("Robocode's window needs a display, and DISPLAY is not set (run it on a desktop, or "
-                               "under xvfb-run)")
     with tempfile.TemporaryDirectory(prefix="confront-robocode-") as tmp:
-        names = [r.name for r in robots if r.is_file()]
-        jars = [run_jar(r, Path(tmp)) if r.is_dir() else r for r in robots]
-        if len({j.name for j in jars}) < len(jars) or any(j.name in names for j in jars if j.parent == Path(tmp)):
-            raise click.UsageError("two of the robots are the same robot class (two runs of one kind, or a jar of "
-                                   "that name): give one of them")
         try:
-            proc = open_robocode(install, jars, workdir, wait=False)  # checks the jars first; copies them in
+            require_display("Robocode's window")  # before exporting anything
+            jars = [run_jar(r, Path(tmp)) if r.is_dir() else r for r in robots]
+            if len({j.name for j in jars}) < len(jars):  # they would land on one file of the robots folder
+                raise ValueError("two of the robots are one jar name (two runs of one kind, or a jar of that name): "
+                                 "give one of them")
+            proc = open_robocode(install, jars, workdir, wait=False)  # checks the jars; copies them in
         except ValueError as err:
             raise click.UsageError(str(err)) from None
     wd = robocode_workdir(install, workdir)

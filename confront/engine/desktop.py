@@ -15,7 +15,7 @@ import subprocess
 from collections.abc import Sequence
 from pathlib import Path
 
-from confront.engine.install import ENGINE_VERSION, HEADLESS, JVM_FLAGS, EngineInstall
+from confront.engine.install import ENGINE_VERSION, HEADLESS, JVM_FLAGS, EngineInstall, require_display
 
 # what Debian's launcher copies into a new working directory (the rest it links)
 COPIED = ("battles", "compilers", "config", "roborumble", "robots", "templates", "theme")
@@ -54,9 +54,7 @@ def open_robocode(install: EngineInstall, robots: Sequence[Path] = (), workdir: 
                   wait: bool = True) -> subprocess.Popen[bytes]:
     """Start Robocode's program with ``robots`` (robot jars) copied into its robots folder; with ``wait``, return
     when its window is closed. Needs a display (``DISPLAY``)."""
-    if not os.environ.get("DISPLAY"):
-        raise ValueError("Robocode's window needs a display, and DISPLAY is not set (run it on a desktop, or under "
-                         "xvfb-run)")
+    require_display("Robocode's window")
     for jar in robots:
         if Path(jar).suffix != ".jar" or not Path(jar).is_file():
             raise ValueError(f"{jar} is not a robot jar: write one with confront export RUN --out NAME.jar")

@@ -29,14 +29,14 @@ from confront.arena.observe import (
     select_targets,
 )
 from confront.engine.bridge import Observation, RobotActing
-from confront.engine.install import EngineInstall, find_engine
+from confront.engine.install import ENGINE_VERSION, EngineInstall, find_engine
 from confront.engine.java_build import compile_java
 
 ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
 POLICY_CLASSES = ("PolicyBot", "PolicyModel", "RoundStart")
 TEAM_SIZE = 4  # the exported team: our side in every team scenario (4v4, 4v6, 4v10)
 # where Debian's robocode (its /usr/games/robocode launcher) keeps the robots it lists
-ROBOTS_FOLDER_HINT = "Debian's robocode: ~/.local/share/robocode/1.9.3.9/robots/ after its first start"
+ROBOTS_FOLDER_HINT = f"Debian's robocode: ~/.local/share/robocode/{ENGINE_VERSION}/robots/ after its first start"
 
 
 @dataclass(frozen=True)

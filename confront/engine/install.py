@@ -24,6 +24,12 @@ JVM_FLAGS: tuple[str, ...] = (
 )
 
 
+def require_display(what: str) -> None:
+    """ValueError naming ``what`` when no display is set: Robocode's windows need one."""
+    if not os.environ.get("DISPLAY"):
+        raise ValueError(f"{what} needs a display, and DISPLAY is not set (run it on a desktop, or under xvfb-run)")
+
+
 class EngineNotFoundError(RuntimeError):
     """The Robocode engine or the Java tools are missing."""
 

@@ -194,8 +194,7 @@ class LearnerPolicy:
         key = (obs.robot, obs.round)
         if key not in self._tanks:
             for robot, round_ in [k for k in self._tanks if k[0] == obs.robot and k[1] < obs.round]:
-                self.lost_ends += self._tanks[(robot, round_)].obs is not None
-                self.end_episode(robot, round_)
+                self._close_unended(robot, round_)
         tank = self._tanks.setdefault(key, _Tank())
         if tank.obs is not None and not obs.history:
             raise ValueError(f"no energy history in {obs.robot}'s observation of turn {obs.turn}: "
@@ -223,5 +222,9 @@ class LearnerPolicy:
         """Close every step still open (a battle ended without a tank's end message): learned as terminal if it
         has reward turns, else dropped; each counts in ``lost_ends``."""
         for robot, round_ in list(self._tanks):
-            self.lost_ends += self._tanks[(robot, round_)].obs is not None
-            self.end_episode(robot, round_)
+            self._close_unended(robot, round_)
+
+    def _close_unended(self, robot: str, round_: int) -> None:
+        """Close a step whose end line never came (counted in ``lost_ends``)."""
+        self.lost_ends += self._tanks[(robot, round_)].obs is not None
+        self.end_episode(robot, round_)

@@ -17,7 +17,7 @@ from typing import Any
 
 from confront.engine.affinity import ONE_CPU_JVM_FLAGS, claimed_cpu
 from confront.engine.battle import BattleSpec
-from confront.engine.install import HEADLESS, JVM_FLAGS, EngineInstall, find_engine
+from confront.engine.install import HEADLESS, JVM_FLAGS, EngineInstall, find_engine, require_display
 from confront.engine.java_build import compile_java
 from confront.engine.workdir import prepare_workdir, write_robot_data
 from confront.results import BattleResults, ScoreRow, parse_results_text
@@ -85,7 +85,7 @@ def java_command(install: EngineInstall, classes: Path, workdir: Path, opts: Eng
                  one_cpu: bool = False) -> list[str]:
     """The JVM command line for the runner (flags from robocode-facts.md section 0; ``one_cpu``: the process
     will run on one CPU, so it compiles with C1 only)."""
-    flags = [f for f in JVM_FLAGS if f != HEADLESS] + ["-Dconfront.visible=true"] if opts.visible else list(JVM_FLAGS)
+    flags = ([f for f in JVM_FLAGS if f != HEADLESS] + ["-Dconfront.visible=true"]) if opts.visible else list(JVM_FLAGS)
     cmd = [install.java, f"-Xmx{opts.max_heap_mb}M", f"-DWORKINGDIRECTORY={workdir}", *flags]
     if one_cpu:
         cmd += list(ONE_CPU_JVM_FLAGS)
@@ -210,9 +210,8 @@ def run_battle(
     robots folders to add (e.g. an exported robot).
     """
     opts = options or EngineOptions()
-    if opts.visible and not os.environ.get("DISPLAY"):
-        raise ValueError("a visible battle needs a display, and DISPLAY is not set (run it on a desktop, or "
-                         "under xvfb-run)")
+    if opts.visible:
+        require_display("a visible battle")
     install = install or find_engine()
     classes = compile_java(install)
     with tempfile.TemporaryDirectory(prefix="confront-robocode-") as tmp:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -235,9 +234,12 @@ def _check_watch(watch: bool, engine: str) -> None:
     if engine != "robocode":
         raise click.UsageError("--watch shows Robocode's own battle window: use it with --engine robocode "
                                "(simulator battles are watched with --replay or confront replay)")
-    if not os.environ.get("DISPLAY"):
-        raise click.UsageError("--watch needs a display, and DISPLAY is not set (run it on a desktop, or under "
-                               "xvfb-run)")
+    from confront.engine.install import require_display
+
+    try:
+        require_display("--watch")
+    except ValueError as err:
+        raise click.UsageError(str(err)) from None
 
 
 def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed: int,

@@ -10,7 +10,10 @@ Layout inside a run folder::
 
 An edited ``meta.json`` (say ``rounds_done``) fails its checksum and is refused; a ``rounds_done`` that does not
 fit the checkpoint's name or its rows is refused too (also for version-1 checkpoints, which had no metadata
-checksum). Saving removes only checkpoints older than the one saved; without ``LATEST`` the newest checkpoint
+checksum). Saving removes only checkpoints older than the one saved, and only folders it wrote itself (a
+``meta.json`` of this format and a ``state.npz``, nothing else; a left-over temporary folder of a killed save):
+a user's ``checkpoints/best/notes.txt`` or ``.git`` stays. A ``checkpoints`` folder that is a symbolic link is
+refused (saving would write, and prune, in whatever folder it points to). Without ``LATEST`` the newest checkpoint
 that verifies is used, and that is said on stderr.
 
 Tables in the metadata (a list of flat rows with one key order and one type per column, such as a run's round
@@ -41,6 +44,8 @@ READ_VERSIONS = (1, 2, 3)
 TABLE = "table."  # npz key prefix of a metadata table's columns
 NAME = re.compile(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}")
 ROUND_NAME = re.compile(r"round-(\d+)")
+TEMP_NAME = re.compile(r"\.[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}\.[A-Za-z0-9_]+")  # tempfile.mkdtemp(prefix=".<name>.")
+FILES = frozenset({"meta.json", "state.npz"})
 
 
 class CheckpointError(RuntimeError):
@@ -139,15 +144,49 @@ def _as_columns(rows: Any) -> list[tuple[str, np.ndarray]] | None:
     return out
 
 
+def _is_ours(folder: Path, temporary: bool = False) -> bool:
+    """True if ``folder`` is a real folder (not a link) that :func:`save` wrote: a complete checkpoint of this
+    format with nothing else in it, or (``temporary``) a save's left-over temporary folder."""
+    if folder.is_symlink() or not folder.is_dir():
+        return False
+    names = {p.name for p in folder.iterdir()}
+    if temporary:
+        return TEMP_NAME.fullmatch(folder.name) is not None and all(
+            n in FILES or (n.startswith(".meta.json.") and n.endswith(".tmp")) for n in names)
+    if names != FILES or not NAME.fullmatch(folder.name) or not (folder / "meta.json").is_file():
+        return False
+    try:
+        with (folder / "meta.json").open("rb") as fh:
+            meta = json.loads(fh.read(1 << 26))
+    except (OSError, ValueError, RecursionError):
+        return False
+    return isinstance(meta, dict) and meta.get("format") == FORMAT
+
+
+def check_folder(directory: str | Path) -> None:
+    """CheckpointError if ``directory`` is a symbolic link or something other than a folder (checkpoints are
+    written, and old ones removed, only in a run's own folder)."""
+    root = Path(directory)
+    if root.is_symlink():
+        raise CheckpointError(f"{root} is a symbolic link: confront writes checkpoints only into a real folder of "
+                              "the run (replace the link by a folder)")
+    if root.exists() and not root.is_dir():
+        raise CheckpointError(f"{root} is not a folder: move it away")
+
+
 def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], meta: Mapping[str, Any],
          keep: int = 2) -> Path:
     """Save a checkpoint ``directory/name`` atomically, point ``LATEST`` at it and keep the newest ``keep``.
 
     Only checkpoints whose names sort before ``name`` are removed: a newer one (say, one written before a resume
-    from an older checkpoint) is never deleted."""
+    from an older checkpoint) is never deleted, nor any folder this function did not write."""
     if not NAME.fullmatch(name):
         raise ValueError(f"checkpoint name {name!r} must be letters, digits, '.', '_' or '-'")
     root = Path(directory)
+    check_folder(root)
+    final = root / name
+    if (final.exists() or final.is_symlink()) and not _is_ours(final):
+        raise CheckpointError(f"{final} exists and is not a checkpoint confront wrote: move it away")
     root.mkdir(parents=True, exist_ok=True)
     if any(k.startswith(TABLE) for k in arrays):
         raise ValueError(f"array names starting with {TABLE!r} are reserved for tables")
@@ -172,7 +211,6 @@ def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], met
         full_meta["meta_sha256"] = _meta_digest(full_meta)
         # key order kept (not sorted), so rows come back with their columns in the order they were written
         write_atomic(tmp / "meta.json", json.dumps(full_meta, indent=1).encode())
-        final = root / name
         if final.exists():
             shutil.rmtree(final)
         os.replace(tmp, final)
@@ -181,11 +219,11 @@ def save(directory: str | Path, name: str, arrays: Mapping[str, np.ndarray], met
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     write_atomic(root / "LATEST", (name + "\n").encode())
-    older = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".") and p.name < name)
+    older = sorted(p for p in root.iterdir() if not p.name.startswith(".") and p.name < name and _is_ours(p))
     for old in older[: max(0, len(older) - (keep - 1))] if keep > 0 else []:
         shutil.rmtree(old, ignore_errors=True)
     for stale in root.glob(".*"):  # leftovers of a save that was killed
-        if stale.is_dir():
+        if _is_ours(stale, temporary=True):
             shutil.rmtree(stale, ignore_errors=True)
     return final
 

@@ -7,11 +7,18 @@
     <run>/checkpoints/         data-only checkpoints (see confront.checkpoint)
     <run>/replays/             optional battle replays
     <run>/summary.json         headline numbers, wall time, versions
+    <run>/.lock                while a run writes the folder (see :class:`RunLock`)
+
+One run at a time writes a run folder: :meth:`Run.create` (with ``lock``) and :meth:`Run.open` hold an exclusive
+``flock`` on ``<run>/.lock`` until :meth:`Run.release`; a second run is refused with :class:`RunBusyError`. The
+kernel drops the lock when its process dies, so a lock file left by a killed run never blocks.
 """
 
 from __future__ import annotations
 
 import csv
+import errno
+import fcntl
 import io
 import json
 import math
@@ -34,6 +41,64 @@ except ImportError:  # pragma: no cover - exercised on installs without the extr
     pq = None
 
 SUBDIRS = ("metrics", "plots", "checkpoints", "replays")
+LOCK = ".lock"
+
+
+class RunBusyError(FileExistsError):
+    """Another run (a live process) holds the run folder's lock."""
+
+
+class RunLock:
+    """An exclusive ``flock`` on ``<folder>/.lock``, holding the writer's process id (for the message)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.path = folder / LOCK
+        self.fd: int | None = None
+        while self.fd is None:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as exc:
+                holder = os.pread(fd, 32, 0).decode(errors="replace").strip()
+                os.close(fd)
+                if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                    raise
+                who = f"process {holder}" if holder.isdigit() else "another process"
+                raise RunBusyError(f"run folder {folder} is being written by another run ({who}): wait until it "
+                                   "ends or give another folder") from None
+            try:  # the previous holder may have removed the file between our open and our lock: then again
+                same = os.stat(self.path, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if not same:
+                os.close(fd)
+                continue
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            self.fd = fd
+
+    def release(self) -> None:
+        """Remove the lock file and drop the lock (removed first, so nobody locks a file that is going away)."""
+        if self.fd is None:
+            return
+        try:
+            self.path.unlink(missing_ok=True)
+        finally:
+            os.close(self.fd)
+            self.fd = None
+
+
+def _check_subfolders(p: Path) -> None:
+    """A run writes into its own sub-folders only: one that is a symbolic link (or a file) is refused."""
+    for sub in SUBDIRS:
+        if (p / sub).is_symlink() or ((p / sub).exists() and not (p / sub).is_dir()):
+            raise FileExistsError(f"{p / sub} is a symbolic link or a file: a run writes only into real "
+                                  "folders of its own (replace it by a folder)")
+
+
+def _entries(p: Path) -> list[str]:
+    """What a folder holds besides a run's lock file."""
+    return [e.name for e in p.iterdir() if e.name != LOCK]
 
 
 def new_run_name(prefix: str) -> str:
@@ -72,22 +137,40 @@ def _csv(rows: Sequence[Mapping[str, Any]], columns: list[str], header: bool) ->
 
 @dataclass(frozen=True)
 class Run:
-    """A run folder. ``new``: :meth:`create` made the folder (so a failed start may remove it again)."""
+    """A run folder. ``new``: :meth:`create` made the folder (so a failed start may remove it again); ``lock``:
+    the run's hold on the folder (:class:`RunLock`), dropped by :meth:`release`."""
 
     path: Path
     new: bool = field(default=False, compare=False)
+    lock: RunLock | None = field(default=None, compare=False, repr=False)
 
     @classmethod
-    def create(cls, path: str | Path, config: Mapping[str, Any] | None = None, exist_ok: bool = False) -> Run:
-        """Make the folder (and its sub-folders); write the resolved config if given."""
+    def create(cls, path: str | Path, config: Mapping[str, Any] | None = None, exist_ok: bool = False,
+               lock: bool = False) -> Run:
+        """Make the folder (and its sub-folders); write the resolved config if given. With ``lock``, hold the
+        folder's lock (:class:`RunBusyError` if another run holds it) until :meth:`release`."""
         p = Path(path)
         if p.exists() and not p.is_dir():
             raise FileExistsError(f"run folder {p} is an existing file; pick another --out")
-        if p.exists() and any(p.iterdir()) and not exist_ok:
+        if p.exists() and _entries(p) and not exist_ok:
             raise FileExistsError(f"run folder {p} already exists; pick another --out or use --resume")
         text = to_toml(config).encode() if config is not None else None  # a value TOML cannot hold fails here
-        run = cls(p, new=not p.exists())
         try:
+            p.mkdir(parents=True)
+            new = True  # made here, by this run alone (mkdir is atomic): a failed start may remove it
+        except FileExistsError:
+            new = False
+        try:
+            held = RunLock(p) if lock else None
+        except BaseException:
+            if new:
+                p.rmdir()
+            raise
+        run = cls(p, new=new, lock=held)
+        try:
+            if not new and _entries(p) and not exist_ok:  # another run got here first
+                raise FileExistsError(f"run folder {p} already exists; pick another --out or use --resume")
+            _check_subfolders(p)
             for sub in SUBDIRS:
                 (p / sub).mkdir(parents=True, exist_ok=True)
             if text is not None:
@@ -97,8 +180,28 @@ class Run:
             raise
         return run
 
+    @classmethod
+    def open(cls, path: str | Path) -> Run:
+        """An existing run folder, locked for this run (to continue it): :class:`RunBusyError` if another run
+        holds it."""
+        p = Path(path)
+        run = cls(p, lock=RunLock(p))
+        try:
+            _check_subfolders(p)
+        except BaseException:
+            run.release()
+            raise
+        return run
+
+    def release(self) -> None:
+        """Drop the folder's lock (if this run holds it)."""
+        if self.lock is not None:
+            self.lock.release()
+
     def discard_if_new(self) -> None:
-        """Remove the folder if :meth:`create` made it (after a failed start); an older folder is left alone."""
+        """Remove the folder if :meth:`create` made it (after a failed start); an older folder is left alone.
+        Drops the lock either way."""
+        self.release()
         if self.new:
             shutil.rmtree(self.path, ignore_errors=True)
 

@@ -21,7 +21,9 @@ naming the file and the problem. GIFs are drawn at most ``MAX_GIF_SIDE`` pixels 
 from __future__ import annotations
 
 import gzip
+import io
 import json
+import re
 import zlib
 from dataclasses import dataclass, field
 from importlib import resources
@@ -32,6 +34,7 @@ import numpy as np
 from PIL import Image
 
 from confront.arena.render import FrameData, draw_frame
+from confront.checkpoint import write_atomic
 
 FORMAT = "confront-replay/1"
 N_ROBOT_FIELDS = 7  # x, y, heading, gun, radar, energy, alive
@@ -202,11 +205,8 @@ class Replay:
     def save(self, path: str | Path) -> Path:
         """Write the replay as compact JSON (gzip when the name ends in .gz)."""
         p = Path(path)
-        text = json.dumps(self.to_dict(), separators=(",", ":"))
-        if p.name.endswith(".gz"):
-            p.write_bytes(gzip.compress(text.encode()))
-        else:
-            p.write_text(text)
+        data = json.dumps(self.to_dict(), separators=(",", ":")).encode()
+        write_atomic(p, gzip.compress(data) if p.name.endswith(".gz") else data)
         return p
 
 
@@ -306,9 +306,12 @@ def write_gif(
         for i in idx
     ]
     p = Path(path)
+    buf = io.BytesIO()
     images[0].save(
-        p, save_all=True, append_images=images[1:], duration=max(20, int(1000 / fps)), loop=0, optimize=False
+        buf, format="GIF", save_all=True, append_images=images[1:], duration=max(20, int(1000 / fps)), loop=0,
+        optimize=False
     )
+    write_atomic(p, buf.getvalue())
     return p
 
 
@@ -320,16 +323,19 @@ def write_html(replay: Replay, path: str | Path, title: str | None = None) -> Pa
     """A single self-contained HTML page (inline JS + canvas) that plays the replay."""
     if len(replay) == 0:
         raise ValueError("replay has no frames")
-    data = json.dumps(replay.to_dict(), separators=(",", ":")).replace("</", "<\\/")
+    # <, > and & only occur inside JSON strings: as \u escapes no name can end the script or open a comment
+    data = (json.dumps(replay.to_dict(), separators=(",", ":"))
+            .replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026"))
     name = title or f"confront replay {replay.scenario}".strip()
-    html = _template().replace("__TITLE__", _escape(name)).replace("__REPLAY_JSON__", data)
+    fill = {"__TITLE__": _escape(name), "__REPLAY_JSON__": data}  # one pass: a name holding a placeholder stays text
+    html = re.sub("__TITLE__|__REPLAY_JSON__", lambda m: fill[m.group(0)], _template())
     p = Path(path)
-    p.write_text(html)
+    write_atomic(p, html.encode())
     return p
 
 
 def _escape(s: str) -> str:
-    return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    return s.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
 
 
 REPLAY_SUFFIXES = (".replay.json", ".replay.json.gz")

@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from confront.experiments.stats import bootstrap_ci  # noqa: E402
+from confront.files import save_figure  # noqa: E402
 
 COLORS = ("tab:red", "tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:brown", "tab:gray")
 
@@ -46,9 +47,7 @@ def plot_curves(curves: Mapping[str, np.ndarray], path: str | Path, *, ylabel: s
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out)
+    out = save_figure(fig, path)
     plt.close(fig)
     return out
 

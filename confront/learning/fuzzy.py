@@ -170,6 +170,9 @@ def plot_fuzzy(path: str | Path, params: FuzzyParams | None = None) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from confront.files import figure_path
+
+    figure_path(path)  # a bad name fails before the drawing
     flr = FuzzyLearningRate(params)
     p = flr.params
     ip, op = np.asarray(p.input_points), np.asarray(p.output_points)
@@ -192,7 +195,6 @@ def plot_fuzzy(path: str | Path, params: FuzzyParams | None = None) -> Path:
     ax_map.set(title="Figure 13: fuzzy learning rate", xlabel="reward r", ylabel="learning rate")
     ax_map.grid(alpha=0.3)
     fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120)
-    return out
+    from confront.files import save_figure
+
+    return save_figure(fig, path, dpi=120)

@@ -129,3 +129,49 @@ def test_export_replays_from_a_run_folder(tmp_path: Path) -> None:
     assert "__REPLAY_JSON__" not in (tmp_path / "out" / "round1.html").read_text()
     with pytest.raises(ValueError, match="neither"):
         find_replays(tmp_path / "missing")
+
+
+def _hostile(n: int = 120) -> Replay:
+    rp = _synthetic(n)
+    rp.names = ["<!--<script>", "</script><b>&amp;__TITLE__"]
+    return rp
+
+
+def test_html_player_escapes_robot_names(tmp_path: Path) -> None:
+    """Issue 34 item 17: a robot name cannot end the player's script, open a comment or fill a placeholder."""
+    page = write_html(_hostile(), tmp_path / "r.html", title="x __REPLAY_JSON__ <y>").read_text()
+    script = page[page.index("const R = "):]
+    script = script[:script.index("</script>")]
+    assert "<!--" not in script and "<script" not in script
+    data = json.loads(script.removeprefix("const R = ").split(";\n", 1)[0])
+    assert data["names"] == ["<!--<script>", "</script><b>&amp;__TITLE__"]
+    assert "<title>x __REPLAY_JSON__ &lt;y&gt;</title>" in page
+
+
+@pytest.mark.browser
+def test_html_player_with_hostile_names_plays_in_chromium(tmp_path: Path) -> None:
+    if _chromium() is None:
+        pytest.skip("chromium not installed")
+    url = write_html(_hostile(), tmp_path / "r.html").resolve().as_uri()
+    dom = _run_chromium(["--virtual-time-budget=1500", "--dump-dom"], url, tmp_path / "p1")
+    m = re.search(r'<body[^>]*data-frame="(\d+)"', dom.stdout)
+    assert m is not None and int(m.group(1)) > 10, dom.stderr[-2000:]
+    assert "&lt;!--&lt;script&gt;" in dom.stdout
+
+
+def test_replay_outputs_replace_a_link_instead_of_following_it(tmp_path: Path) -> None:
+    """Issue 34 item 3: a symlinked output name is replaced by the new file; the link's target is unchanged."""
+    from confront.arena.replay import export_replays
+
+    target = tmp_path / "precious.txt"
+    target.write_text("keep")
+    _synthetic(10).save(tmp_path / "ok.replay.json")
+    for name in ("ok.html", "ok.gif"):
+        (tmp_path / name).symlink_to(target)
+    export_replays(tmp_path / "ok.replay.json")
+    assert target.read_text() == "keep"
+    assert not (tmp_path / "ok.html").is_symlink() and "const R" in (tmp_path / "ok.html").read_text()
+    assert not (tmp_path / "ok.gif").is_symlink()
+    (tmp_path / "r.json").symlink_to(target)
+    _synthetic(5).save(tmp_path / "r.json")
+    assert target.read_text() == "keep" and len(load_replay(tmp_path / "r.json")) == 5

@@ -158,3 +158,44 @@ def test_checkpoint_rows_keep_their_column_order(tmp_path: Path) -> None:
     rows = [{"zeta": 1, "alpha": 2, "mid": 3}]
     path = ck.save(tmp_path, "round-000001", {"w": np.zeros(1)}, {"rounds_done": 1, "rows": rows})
     assert list(ck.load(path)[1]["rows"][0]) == ["zeta", "alpha", "mid"]
+
+
+def test_save_deletes_only_checkpoints_it_wrote(tmp_path: Path) -> None:
+    """Issue 34 item 1: a user's folders in checkpoints/ (sorting before the new name, or hidden) stay."""
+    root = tmp_path / "checkpoints"
+    _save(root, "round-000002", 1.0)
+    (root / "best").mkdir()
+    (root / "best" / "notes.txt").write_text("n\n")
+    (root / ".git").mkdir()
+    (root / ".git" / "HEAD").write_text("ref\n")
+    (root / "aaa-mine").mkdir()  # empty, sorts first
+    (root / "round-000001").mkdir()  # a checkpoint's name, but not one confront wrote
+    (root / "round-000001" / "meta.json").write_text('{"format": "mine"}')
+    (root / "round-000001" / "state.npz").write_bytes(b"x")
+    stale = root / ".round-000003.abcd_123"  # a killed save's temporary folder
+    stale.mkdir()
+    (stale / "state.npz").write_bytes(b"half")
+    _save(root, "round-000004", 2.0)
+    _save(root, "round-000006", 3.0)
+    assert (root / "best" / "notes.txt").read_text() == "n\n" and (root / ".git" / "HEAD").read_text() == "ref\n"
+    assert (root / "aaa-mine").is_dir() and (root / "round-000001" / "meta.json").is_file()
+    assert not stale.exists() and not (root / "round-000002").exists()
+    assert (root / "round-000004").is_dir() and (root / "round-000006").is_dir()
+
+
+def test_save_refuses_a_symlinked_checkpoints_folder_and_a_foreign_name(tmp_path: Path) -> None:
+    """Issue 34 item 1: a checkpoints folder linked to a shared folder is not written into or pruned."""
+    shared = tmp_path / "shared"
+    (shared / "other").mkdir(parents=True)
+    _save(shared, "round-000001", 1.0)  # another run's checkpoint there
+    link = tmp_path / "checkpoints"
+    link.symlink_to(shared)
+    with pytest.raises(ck.CheckpointError, match="symbolic link"):
+        _save(link, "round-000009", 2.0)
+    assert sorted(p.name for p in shared.iterdir()) == ["LATEST", "other", "round-000001"]
+    mine = tmp_path / "mine"
+    (mine / "round-000003").mkdir(parents=True)
+    (mine / "round-000003" / "keep.txt").write_text("k")
+    with pytest.raises(ck.CheckpointError, match="not a checkpoint confront wrote"):
+        _save(mine, "round-000003", 2.0)
+    assert (mine / "round-000003" / "keep.txt").read_text() == "k"

@@ -1,6 +1,9 @@
 """Run folders: layout, tables in CSV (and Parquet), atomic JSON."""
 
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -45,3 +48,56 @@ def test_existing_run_folder_is_not_overwritten(tmp_path: Path) -> None:
     Run.create(tmp_path / "r", {})
     with pytest.raises(FileExistsError, match="already exists"):
         Run.create(tmp_path / "r", {})
+
+
+def test_one_run_at_a_time_writes_a_run_folder(tmp_path: Path) -> None:
+    """Issue 34 item 2: a second run into a folder being written is refused; the first is unharmed."""
+    from confront.runs import RunBusyError
+
+    first = Run.create(tmp_path / "r", {"a": 1}, lock=True)
+    with pytest.raises(RunBusyError, match=f"being written by another run \\(process {os.getpid()}\\)"):
+        Run.create(tmp_path / "r", {"a": 2}, exist_ok=True, lock=True)
+    with pytest.raises(RunBusyError):
+        Run.open(tmp_path / "r")
+    assert (first.path / "config.toml").read_text() == "a = 1\n" and first.path.is_dir()
+    first.release()
+    assert not (first.path / ".lock").exists()
+    again = Run.open(tmp_path / "r")
+    again.release()
+    # a new folder that another run locked first is not removed by the loser
+    pre = Run.create(tmp_path / "p", lock=True)
+    with pytest.raises(RunBusyError):
+        Run.create(tmp_path / "p", {"a": 2}, exist_ok=True, lock=True).discard_if_new()
+    assert pre.path.is_dir()
+    pre.release()
+
+
+def test_a_dead_runs_lock_does_not_block(tmp_path: Path) -> None:
+    """Issue 34 item 2: the lock of a killed process (its .lock file left behind) is taken over."""
+    folder = tmp_path / "r"
+    Run.create(folder).release()
+    code = ("import sys, time; from pathlib import Path; from confront.runs import Run; "
+            "Run.open(Path(sys.argv[1])); print('locked', flush=True); time.sleep(60)")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(folder)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "locked"
+        with pytest.raises(FileExistsError, match=f"process {proc.pid}"):
+            Run.open(folder)
+    finally:
+        proc.kill()
+        proc.wait()
+    assert (folder / ".lock").exists()  # left by the killed run
+    Run.open(folder).release()
+
+
+def test_symlinked_run_subfolder_is_refused(tmp_path: Path) -> None:
+    """Issue 34 item 3: a run never writes through a linked plots/ or checkpoints/ folder."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    folder = tmp_path / "r"
+    Run.create(folder).release()
+    (folder / "plots").rmdir()
+    (folder / "plots").symlink_to(elsewhere)
+    with pytest.raises(FileExistsError, match="symbolic link"):
+        Run.open(folder)
+    assert list(elsewhere.iterdir()) == [] and not (folder / ".lock").exists()

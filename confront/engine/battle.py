@@ -58,9 +58,13 @@ def robot_class(name: str) -> str:
         return name
     if name in SAMPLE_TEAM_ROBOTS:
         return f"sampleteam.{name}"
+    from confront.engine.tech_robots import TECH_ROBOTS, engine_name
+
+    if name in TECH_ROBOTS:
+        return engine_name(name)
     if name not in SAMPLE_ROBOTS:
         raise ValueError(f"unknown robot {name!r}: give a package-qualified class or one of "
-                         f"{SAMPLE_ROBOTS + SAMPLE_TEAM_ROBOTS}")
+                         f"{SAMPLE_ROBOTS + SAMPLE_TEAM_ROBOTS + tuple(TECH_ROBOTS)}")
     return f"sample.{name}"
 
 

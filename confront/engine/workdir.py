@@ -26,8 +26,9 @@ def prepare_workdir(
     """Create (or refresh) a working directory at ``path`` and return it.
 
     The CPU constant (robot time per turn) is written to config/robocode.properties so the engine does not
-    run its 5 s benchmark; sample robots, the project's robots and ``extra_robots`` (robot jars, or folders
-    holding package folders, e.g. an exported robot) are copied into robots/.
+    run its 5 s benchmark; sample robots, the project's robots (the technique robots as a jar) and
+    ``extra_robots`` (robot jars, or folders holding package folders, e.g. an exported robot) are copied into
+    robots/.
     """
     if not cpu_constant_ms > 0:
         raise ValueError(f"cpu_constant_ms must be > 0, got {cpu_constant_ms}")
@@ -53,6 +54,10 @@ def prepare_workdir(
         (ours / f"{cls}.properties").write_text(
             f"robot.classname=confront.{cls}\nrobot.name={cls}\nrobocode.version=1.9.3.9\n"
         )
+    if (classes / "confront" / "tech").is_dir():  # the technique robots (confront.tech.*), as one jar
+        from confront.engine.tech_robots import JAR_NAME, cached_tech_jar
+
+        shutil.copy2(cached_tech_jar(classes), robots / JAR_NAME)
     for extra in extra_robots:
         extra = Path(extra)
         if extra.suffix == ".jar":

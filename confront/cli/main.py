@@ -254,6 +254,35 @@ def export(run: Path, out: Path, play: str | None) -> None:
 
 
 @cli.command()
+@click.argument("candidate")
+@click.argument("folder", type=click.Path(path_type=Path))
+@click.option("--mode", type=click.Choice(["1v1", "teams", "melee"]), default="1v1", show_default=True,
+              help="1v1; teams (a team of --team-size of the candidate against as many of each robot, or each team "
+              "jar); melee (the candidate among up to 9 others).")
+@click.option("--seeds", type=COUNT, default=1, show_default=True, help="Battles per opponent (engine seeds 0..N-1).")
+@click.option("--rounds", type=COUNT, default=None, help="Rounds per battle (default: the RoboRumble's, 35; teams 10).")
+@click.option("--field", default=None, help="WIDTHxHEIGHT (default 800x600; melee 1000x1000; teams 1200x1200).")
+@click.option("--cpu-constant", type=float, default=10.0, show_default=True, help="Robot time per turn, ms.")
+@click.option("--team-size", type=click.IntRange(1, 10), default=4, show_default=True)
+@click.option("--workers", type=COUNT, default=None, help="Battles at once on this machine (default: its cores).")
+@click.option("--address", default=None, help="Run each battle as a task on this Ray cluster (ray://HOST:PORT, auto).")
+@click.option("--timeout", type=click.FloatRange(min=1), default=None,
+              help="Seconds after which a battle's JVM is killed (default from rounds and robots).")
+@click.option("--out", type=click.Path(path_type=Path, file_okay=False), default=None,
+              help="Output folder (resumable; default rumbles/<candidate>-<mode>).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def rumble(candidate: str, folder: Path, mode: str, seeds: int, rounds: int | None, field: str | None,
+           cpu_constant: float, team_size: int, workers: int | None, address: str | None, timeout: float | None,
+           out: Path | None, quiet: bool) -> None:
+    """CANDIDATE (a trained run folder, a robot jar or a class such as sample.Tracker) against every robot of the
+    jars in FOLDER, in the real engine: a table per opponent (APS, survival, bullet damage, 95% interval)."""
+    from confront.experiments.rumble import rumble_cli
+
+    rumble_cli(candidate, folder, mode=mode, seeds=seeds, rounds=rounds, field=field, cpu_constant=cpu_constant,
+               team_size=team_size, workers=workers, address=address, out=out, timeout=timeout, quiet=quiet)
+
+
+@cli.command()
 @click.argument("source", type=click.Path(path_type=Path, exists=True))
 @click.option("--out", type=click.Path(path_type=Path), default=None, help="Output stem (default beside the source).")
 def replay(source: Path, out: Path | None) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 from scipy import optimize, stats
 
 __all__ = ["Interval", "Paired", "SignTest", "bootstrap_ci", "hedges_g", "interval", "mde_sign", "mde_t",
-           "median_ci", "paired_comparison", "paired_permutation_test", "permutation_test", "sign_test"]
+           "median_ci", "paired_comparison", "paired_permutation_test", "permutation_test", "sign_test", "t_interval"]
 
 ALTERNATIVES = ("greater", "less", "two-sided")
 
@@ -144,6 +144,20 @@ def mde_sign(n: int, alpha: float = 0.05, power: float = 0.8, two_sided: bool = 
     if k > n:
         return float("nan")
     return float(optimize.brentq(lambda p: stats.binom.sf(k - 1, n, p) - power, 0.5, 1.0))
+
+
+def t_interval(x: np.ndarray, level: float = 0.95) -> Interval:
+    """Mean and Student-t interval of the mean, mean +- t(level, n-1) * s / sqrt(n) (NaN dropped; fewer than two
+    values: NaN bounds, no spread to measure)."""
+    x = np.asarray(x, dtype=np.float64)
+    x = x[~np.isnan(x)]
+    if x.size == 0:
+        return Interval(float("nan"), float("nan"), float("nan"))
+    mean = float(x.mean())
+    if x.size < 2:
+        return Interval(mean, float("nan"), float("nan"))
+    half = float(stats.t.ppf(0.5 + level / 2, x.size - 1) * x.std(ddof=1) / np.sqrt(x.size))
+    return Interval(mean, mean - half, mean + half)
 
 
 def median_ci(x: np.ndarray, level: float = 0.95) -> Interval:

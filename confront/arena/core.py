@@ -77,6 +77,8 @@ from typing import Any
 
 import numpy as np
 
+from confront.config import ConfigError
+
 from . import _kernels as K
 from .rules import java_next_double, java_seed
 from .scenarios import Scenario, get_scenario
@@ -119,8 +121,8 @@ def default_threads() -> int:
     """Threads for batched steps: CONFRONT_THREADS, else the CPUs this process may use."""
     env = os.environ.get("CONFRONT_THREADS")
     if env is not None:
-        if not env.isdigit() or int(env) < 1:
-            raise ValueError(f"CONFRONT_THREADS must be a positive integer, got {env!r}")
+        if not env.isascii() or not env.isdigit() or not 1 <= int(env) <= 4096:
+            raise ConfigError(f"CONFRONT_THREADS must be a whole number from 1 to 4096, got {env[:40]!r}")
         return int(env)
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 

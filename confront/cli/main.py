@@ -19,10 +19,23 @@ USER_ERRORS: tuple[type[BaseException], ...] = (ConfigError, CheckpointError, Fi
 EXTRAS = {"ray": "distributed", "pyarrow": "parquet", "stable_baselines3": "baselines", "torch": "baselines"}
 SEED = click.IntRange(0, 2**32 - 1)
 COUNT = click.IntRange(min=1)
+ROUNDS = click.IntRange(1, 2**31 - 1)  # Robocode's numRounds is a Java int
 
 
 def _one_line(text: str) -> str:
     return " ".join(str(text).split())
+
+
+def _short_path(name: object, limit: int = 100) -> str:
+    text = str(name)
+    return text if len(text) <= limit else f"{text[:limit // 2 - 2]}...{text[-(limit // 2 - 1):]}"
+
+
+def _os_error(exc: OSError) -> str:
+    """A file system's refusal (read-only, full, a name too long, no permission) in one line naming the path."""
+    why = exc.strerror or _one_line(str(exc)) or type(exc).__name__
+    where = [_short_path(f) for f in (exc.filename, exc.filename2) if f is not None]
+    return f"{' -> '.join(where)}: {why}" if where else why
 
 
 class Group(click.Group):
@@ -40,6 +53,9 @@ class Group(click.Group):
             sys.exit(2)
         except USER_ERRORS + _engine_errors() as exc:
             click.echo(f"error: {_one_line(str(exc))}", err=True)
+            sys.exit(2)
+        except OSError as exc:  # after the FileNotFoundError & co. above, whose messages are the project's own
+            click.echo(f"error: {_one_line(_os_error(exc))}", err=True)
             sys.exit(2)
         except ModuleNotFoundError as exc:
             top = (exc.name or "").split(".")[0]
@@ -135,7 +151,7 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
 @click.option("--opponents", default=None, help="Comma list of opponents (default: the run's).")
-@click.option("--rounds", type=COUNT, default=100, show_default=True)
+@click.option("--rounds", type=ROUNDS, default=100, show_default=True)
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--play", type=click.Choice(["sampled", "greedy"]), default=None,
               help="PPO tanks: sample each action head (the default, as `confront export` plays) or take its "
@@ -153,11 +169,11 @@ def evaluate(run: Path, engine: str, opponents: str | None, rounds: int, seed: i
 
 @cli.command()
 @click.argument("experiment", type=click.Choice(["migration", "awm", "fuzzy", "transfer", "baselines", "all"]))
-@click.option("--seeds", type=int, default=None, help="Seeds per arm, at least 1 (default 10; migration alone 1000).")
-@click.option("--rounds", type=int, default=None, help="Rounds per arm (default from the config).")
+@click.option("--seeds", type=COUNT, default=None, help="Seeds per arm, at least 1 (default 10; migration alone 1000).")
+@click.option("--rounds", type=ROUNDS, default=None, help="Rounds per arm (default from the config).")
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
 @click.option("--out", type=click.Path(path_type=Path), default=None, help="Output folder (default results/).")
-@click.option("--workers", type=int, default=None, help="Parallel worker processes (default: all cores).")
+@click.option("--workers", type=COUNT, default=None, help="Parallel worker processes (default: all cores).")
 @set_option
 def reproduce(experiment: str, seeds: int | None, rounds: int | None, engine: str, out: Path | None,
               workers: int | None, overrides: tuple[str, ...]) -> None:
@@ -184,7 +200,7 @@ def sweep(grid: Path, out: Path, address: str | None, seeds: int | None) -> None
 @click.option("--scenario", default="1v1", show_default=True)
 @click.option("--robots", default=None, help="Comma list of robots/teams (default: the scenario's).")
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
-@click.option("--rounds", type=COUNT, default=10, show_default=True)
+@click.option("--rounds", type=ROUNDS, default=10, show_default=True)
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--battles", type=COUNT, default=1, show_default=True,
               help="Simulator: split the rounds over this many parallel battles (faster; battle b has seed+b).")
@@ -351,8 +367,11 @@ def plot_fuzzy_cmd(out: Path) -> None:
     """Figure 13: the fuzzy learning rate as a function of the reward."""
     from confront.learning.fuzzy import plot_fuzzy
 
-    plot_fuzzy(out)
-    click.echo(f"wrote {out}")
+    try:
+        written = plot_fuzzy(out)
+    except ValueError as err:
+        raise click.UsageError(str(err)) from None
+    click.echo(f"wrote {written}")
 
 
 def main() -> None:

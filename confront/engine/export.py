@@ -28,12 +28,13 @@ from confront.arena.observe import (
     robot_observation,
     select_targets,
 )
+from confront.checkpoint import write_atomic
 from confront.engine.bridge import Observation, RobotActing
 from confront.engine.install import ENGINE_VERSION, EngineInstall, find_engine
-from confront.engine.java_build import compile_java
+from confront.engine.java_build import MODEL_CLASSES, ROBOT_HELPERS, compile_java
 
 ACTIVATIONS = ("bipolar", "tanh", "relu", "linear")
-POLICY_CLASSES = ("PolicyBot", "PolicyModel", "RoundStart")
+POLICY_CLASSES = ("PolicyBot", "PolicyModel", *MODEL_CLASSES, *ROBOT_HELPERS)
 TEAM_SIZE = 4  # the exported team: our side in every team scenario (4v4, 4v6, 4v10)
 # where Debian's robocode (its /usr/games/robocode launcher) keeps the robots it lists
 ROBOTS_FOLDER_HINT = f"Debian's robocode: ~/.local/share/robocode/{ENGINE_VERSION}/robots/ after its first start"
@@ -283,8 +284,9 @@ def export_robot(policy: ExportedPolicy, out: str | Path, install: EngineInstall
                  version: str = "1.0") -> Path:
     """Write the standalone robot ``confront.PolicyBot`` with ``policy``: a robots folder or a ``.jar``.
 
-    A folder gets ``confront/PolicyBot.class``, ``PolicyModel.class``, ``PolicyData.class`` (the policy
-    compiled in as string constants, so the robot reads no file), ``PolicyBot.properties``, ``policy.txt``,
+    A folder gets ``confront/PolicyBot.class``, ``PolicyModel.class``, the classes it shares with TankBot
+    (:data:`POLICY_CLASSES`), ``PolicyData.class`` (the policy compiled in as string constants, so the robot
+    reads no file), ``PolicyBot.properties``, ``policy.txt``,
     the team ``PolicyTeam.team`` (four PolicyBots, the paper's team size) and the Java sources; a jar holds the same
     files and can be dropped into Robocode's robots folder.
     """
@@ -328,9 +330,9 @@ def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str |
                                    str(pkg / f"{data}.java")], capture_output=True, text=True, check=False)
             if proc.returncode != 0:
                 raise RuntimeError(f"javac failed on the policy data:\n{proc.stderr.strip()}")
-        if out.suffix == ".jar":
+        if out.suffix == ".jar":  # built aside, then put in place atomically (a link there is replaced)
             jar = shutil.which("jar") or str(Path(install.javac).with_name("jar"))
-            out.parent.mkdir(parents=True, exist_ok=True)
-            subprocess.run([jar, "cf", str(out.resolve()), "-C", str(root), "."], check=True,
-                           capture_output=True)
+            built = Path(tmp) / "robot.jar"
+            subprocess.run([jar, "cf", str(built), "-C", str(root), "."], check=True, capture_output=True)
+            write_atomic(out, built.read_bytes())
     return out

@@ -479,6 +479,9 @@ def reproduce(experiment: str, seeds: int | None = None, rounds: int | None = No
     1000 (all side by side in seconds)."""
     if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1):
         raise ValueError(f"bad value seeds={seeds!r}: must be a whole number >= 1")
+    for key, value in (("rounds", rounds), ("workers", workers)):  # checked before the output folder is made
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
+            raise ValueError(f"bad value {key}={value!r}: must be a whole number >= 1")
     out = Path(out or ("results" if engine == "sim" else "results-robocode"))
     out.mkdir(parents=True, exist_ok=True)
     names = [e for e in EXPERIMENTS if e != "baselines"] if experiment == "all" else [experiment]
@@ -542,16 +545,8 @@ def restate(out: Path, battle_seeds: int = 10, migration_seeds: int = MIGRATION_
     return outcomes
 
 
-class BadSeeds(click.ClickException):
-    """A refused seed count: one line on stderr, exit status 2 (a usage error)."""
-
-    exit_code = 2
-
-
 def reproduce_cli(experiment: str, seeds: int | None, rounds: int | None, engine: str, out: Path | None,
                   workers: int | None, overrides: tuple[str, ...]) -> None:
-    if seeds is not None and seeds < 1:
-        raise BadSeeds(f"--seeds must be at least 1, got {seeds} (no run was started)")
     if engine == "robocode" and experiment in ("baselines", "all"):
         raise click.UsageError("--engine robocode runs awm, fuzzy or transfer (hours at 500 rounds per run); "
                                "migration needs no engine and the SB3 baselines train in the simulator")

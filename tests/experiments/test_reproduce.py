@@ -118,18 +118,24 @@ def test_arms_of_one_seed_share_the_world_and_the_opponent(tiny: Path) -> None:
     assert td_team(cfgs[0], 4)[1] == td_team(cfgs[1], 4)[1]
 
 
-def test_bad_seed_counts_are_refused_in_one_line() -> None:
+def test_bad_seed_counts_are_refused_in_one_line(tmp_path: Path) -> None:
     from click.testing import CliRunner
 
     from confront.cli.main import cli
 
-    for bad in ("0", "-1"):
-        res = CliRunner().invoke(cli, ["reproduce", "migration", "--seeds", bad])
-        assert res.exit_code == 2
-        assert res.output.strip() == f"Error: --seeds must be at least 1, got {bad} (no run was started)"
+    for option in ("--seeds", "--rounds", "--workers"):  # issue 34 item 19: --rounds and --workers too
+        for bad in ("0", "-5"):
+            res = CliRunner().invoke(cli, ["reproduce", "migration", option, bad])
+            assert res.exit_code == 2
+            line = res.output.strip()
+            assert line.startswith(f"error: Invalid value for '{option}'") and "\n" not in line, line
     for bad in (0, -1):
         with pytest.raises(ValueError, match="seeds"):
             reproduce("migration", seeds=bad)
+        for key in ("rounds", "workers"):
+            with pytest.raises(ValueError, match=key):
+                reproduce("fuzzy", out=tmp_path / "out", **{key: bad})
+    assert not (tmp_path / "out").exists()
 
 
 def test_paired_compare_gives_three_verdicts() -> None:

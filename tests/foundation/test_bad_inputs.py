@@ -123,6 +123,18 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
     ("demo of 0 rounds", ["demo", "--rounds", "0"], "--rounds", None),
     ("config show with a bad override", ["config", "show", "demo", "--set", "learner.hidden=[-3]"],
      "learner.hidden[0]", None),
+    # issue 34 item 4: file systems that refuse (read-only, a name too long) are one line too
+    ("read-only --out", ["train", *TINY, "--out", "/sys/confront-run", "--quiet"], "/sys/confront-run", None),
+    ("--out name of 300 characters", ["train", *TINY, "--out", "{ws}/" + "r" * 300, "--quiet"], "too long", None),
+    ("--replay name of 300 characters", ["battle", "--rounds", "1", "--replay", "{ws}/" + "r" * 300 + ".json"],
+     "too long", None),
+    ("export to a read-only .jar", ["export", "{ws}/run", "--out", "/sys/confront.jar"], "/sys", None),
+    ("plot fuzzy of an unknown format", ["plot", "fuzzy", "--out", "{ws}/x.xyz"], ".png", "x.xyz"),
+    # issue 34 item 16: a folder is not a figure's name (it wrote adir.png and said "wrote adir")
+    ("plot fuzzy into a folder", ["plot", "fuzzy", "--out", "{ws}/adir"], "is a folder", "adir.png"),
+    # issue 34 item 10: Robocode's numRounds is a Java int
+    ("battle of 2^32+1 rounds", ["battle", "--engine", "robocode", "--rounds", "4294967297"], "--rounds", None),
+    ("evaluate 2^31 rounds", ["evaluate", "{ws}/run", "--rounds", str(2**31)], "--rounds", None),
 ]
 
 
@@ -208,3 +220,55 @@ def test_demo_rounds_below_its_session_are_allowed(monkeypatch: pytest.MonkeyPat
     assert result.exit_code == 0, result.output
     assert (got[0].train.rounds, got[0].train.session_rounds) == (8, 8)
     assert "sessions of 8 rounds" in result.stderr
+
+
+ENV_CASES = [  # issue 34 items 4 and 5: (variable, value, arguments, text the error line must contain)
+    ("CONFRONT_THREADS", "abc", ["battle", "--rounds", "1"], "CONFRONT_THREADS"),
+    ("CONFRONT_THREADS", "0", ["battle", "--rounds", "1"], "CONFRONT_THREADS"),
+    ("CONFRONT_THREADS", "-1", ["battle", "--rounds", "1"], "CONFRONT_THREADS"),
+    ("CONFRONT_CACHE", "/sys/confront-cache", ["train", "--set", "train.rounds=2", "--set", "train.session_rounds=2",
+                                               "--set", "opponent.pretrain_rounds=2", "--out", "{ws}/new", "--quiet"],
+     "/sys/confront-cache"),
+]
+
+
+@pytest.mark.parametrize(("var", "value", "args", "expect"), ENV_CASES, ids=[f"{c[0]}={c[1]}" for c in ENV_CASES])
+def test_bad_environment_is_one_line_exit_2(ws: Path, var: str, value: str, args: list[str], expect: str,
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("CONFRONT_CACHE", str(ws / "cache"))
+    monkeypatch.setenv(var, value)
+    before = _snapshot(ws)
+    result = CliRunner().invoke(cli, [a.replace("{ws}", str(ws)) for a in args])
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2, (result.output, result.exception)
+    assert len(lines) == 1 and lines[0].startswith("error: ") and expect in lines[0], result.stderr
+    assert {k: v for k, v in _snapshot(ws).items() if not k.startswith("cache")} == {
+        k: v for k, v in before.items() if not k.startswith("cache")}
+    assert not (ws / "new").exists()
+
+
+def _full_disk(*args: object, **kwargs: object) -> None:
+    import errno
+    import os
+
+    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+def test_full_disk_at_start_is_one_line_and_leaves_no_folder(ws: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 34 item 4: the disk is full when the run folder's config is written."""
+    monkeypatch.setenv("CONFRONT_CACHE", str(ws / "cache"))
+    monkeypatch.setattr("confront.runs.write_atomic", _full_disk)
+    result = CliRunner().invoke(cli, ["train", *TINY, "--out", str(ws / "full"), "--quiet"])
+    assert result.exit_code == 2 and result.stderr == "error: No space left on device\n", result.output
+    assert not (ws / "full").exists()
+
+
+def test_full_disk_at_a_checkpoint_is_one_line_and_keeps_the_run(ws: Path, tmp_path: Path,
+                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 34 item 4: the disk fills up at a checkpoint: one line; the folder (config, metrics) stays."""
+    monkeypatch.setenv("CONFRONT_CACHE", str(ws / "cache"))
+    monkeypatch.setattr("confront.checkpoint._savez", _full_disk)
+    result = CliRunner().invoke(cli, ["train", *TINY, "--out", str(tmp_path / "run"), "--quiet"])
+    assert result.exit_code == 2 and result.stderr == "error: No space left on device\n", result.output
+    assert (tmp_path / "run" / "config.toml").is_file()
+    assert [p.name for p in (tmp_path / "run" / "checkpoints").iterdir()] == []

@@ -24,6 +24,7 @@ from typing import Any, TypeVar
 
 T = TypeVar("T")
 MAX_STRING = 4096  # characters of a string value
+MAX_FILE = 1 << 20  # bytes of a config or scenario file (the largest packaged one has about 2 KB)
 
 
 class ConfigError(ValueError):
@@ -227,26 +228,36 @@ def parse_override(text: str) -> dict[str, Any]:
     return out
 
 
+def _short(p: Path) -> str:
+    text = repr(str(p))
+    return text if len(text) <= 120 else text[:58] + "..." + text[-58:]
+
+
 def load_toml(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file; a missing or malformed file is a ConfigError."""
+    """Read a TOML file of at most ``MAX_FILE`` bytes; a missing, malformed or larger file is a ConfigError."""
     p = Path(path)
     try:
         with p.open("rb") as fh:
-            return tomllib.load(fh)
+            raw = fh.read(MAX_FILE + 1)  # a bounded read: /dev/zero or a huge file is refused, not loaded
+        if len(raw) > MAX_FILE:
+            raise ConfigError(f"config file {_short(p)} is larger than {MAX_FILE >> 20} MB: give a TOML config")
+        return tomllib.loads(raw.decode("utf-8"))
+    except ConfigError:
+        raise
     except FileNotFoundError:
-        raise ConfigError(f"config file {str(p)!r} does not exist") from None
+        raise ConfigError(f"config file {_short(p)} does not exist") from None
     except IsADirectoryError:
-        raise ConfigError(f"config file {str(p)!r} is a folder: give a TOML file") from None
+        raise ConfigError(f"config file {_short(p)} is a folder: give a TOML file") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"config file {str(p)!r} is not valid TOML: {str(exc).splitlines()[0]}") from None
+        raise ConfigError(f"config file {_short(p)} is not valid TOML: {str(exc).splitlines()[0]}") from None
     except UnicodeDecodeError:
-        raise ConfigError(f"config file {str(p)!r} is not valid TOML: it is not UTF-8 text") from None
+        raise ConfigError(f"config file {_short(p)} is not valid TOML: it is not UTF-8 text") from None
     except ValueError as exc:  # e.g. an integer of more than 4300 digits
-        raise ConfigError(f"config file {str(p)!r} cannot be read: {str(exc).splitlines()[0][:120]}") from None
+        raise ConfigError(f"config file {_short(p)} cannot be read: {str(exc).splitlines()[0][:120]}") from None
     except RecursionError:
-        raise ConfigError(f"config file {str(p)!r} is nested too deeply") from None
+        raise ConfigError(f"config file {_short(p)} is nested too deeply") from None
     except OSError as exc:
-        raise ConfigError(f"config file {str(p)!r} cannot be read: {exc.strerror}") from None
+        raise ConfigError(f"config file {_short(p)} cannot be read: {exc.strerror}") from None
 
 
 _ESCAPES = {'"': '\\"', "\\": "\\\\", "\n": "\\n", "\t": "\\t", "\r": "\\r", "\b": "\\b", "\f": "\\f"}

@@ -27,12 +27,14 @@ import math
 import tomllib
 from dataclasses import dataclass, field, fields
 from importlib import resources
+from numbers import Integral
 from pathlib import Path
 from typing import Any
 
 __all__ = ["Scenario", "get_scenario", "load_scenario", "scenario_names", "scenario_from_dict", "SAMPLE_TEAMS",
            "team_members", "opponent_members"]
 
+MAX_ROBOTS = 256  # robots of a battle (the replay format's limit; the simulator's arrays grow with its square)
 # Robocode's sample team (sampleteam.MyFirstTeam): its leader first, then droids to fill the team
 SAMPLE_TEAMS = {"MyFirstTeam": ("MyFirstLeader", "MyFirstDroid")}
 
@@ -67,8 +69,12 @@ class Scenario:
     description: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
-        if not self.teams or any(int(t) < 1 for t in self.teams):
-            raise ValueError(f"teams must be a non-empty list of positive sizes, got {self.teams!r}")
+        if not self.teams or any(isinstance(t, bool) or not isinstance(t, Integral) or t < 1 for t in self.teams):
+            raise ValueError(f"teams must be a non-empty list of positive whole sizes, got {_show(self.teams)}")
+        object.__setattr__(self, "teams", tuple(int(t) for t in self.teams))
+        if sum(self.teams) > MAX_ROBOTS:
+            raise ValueError(f"teams={_show(self.teams)} make {sum(self.teams)} robots: a battle holds at most "
+                             f"{MAX_ROBOTS}")
         if len(self.teams) < 2 and self.teams[0] < 2:
             raise ValueError(f"teams={self.teams!r}: a battle needs at least two robots")
         if not (400 <= self.width <= 5000 and 400 <= self.height <= 5000):  # [BattlefieldSpecification]
@@ -122,6 +128,11 @@ def opponent_members(scenario: Scenario, name: str) -> list[str]:
 _FIELDS = {f.name for f in fields(Scenario)}
 
 
+def _show(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def scenario_from_dict(d: dict[str, Any]) -> Scenario:
     """Build a validated Scenario from a plain dict (TOML table)."""
     for k in d:
@@ -130,7 +141,9 @@ def scenario_from_dict(d: dict[str, Any]) -> Scenario:
     if "name" not in d or "teams" not in d:
         raise ValueError("a scenario needs 'name' and 'teams'")
     d = dict(d)
-    d["teams"] = tuple(int(t) for t in d["teams"])
+    if isinstance(d["teams"], str) or not isinstance(d["teams"], list | tuple):
+        raise ValueError(f"teams must be a list of team sizes, got {_show(d['teams'])}")
+    d["teams"] = tuple(d["teams"])  # whole numbers only: 1.7 is refused, not read as 1
     for k in ("width", "height", "gun_cooling_rate"):
         if k in d:
             d[k] = float(d[k])
@@ -144,10 +157,10 @@ def scenario_from_dict(d: dict[str, Any]) -> Scenario:
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read a user scenario from a TOML file."""
-    with open(path, "rb") as f:
-        d = tomllib.load(f)
-    return scenario_from_dict(d)
+    """Read a user scenario from a TOML file (at most ``confront.config.MAX_FILE`` bytes)."""
+    from confront.config import load_toml
+
+    return scenario_from_dict(load_toml(path))
 
 
 def _builtin_dir() -> Any:

@@ -48,6 +48,9 @@ def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (root / "adir").mkdir()
     (root / "latin1.toml").write_bytes('name = "d\xe9mo"\n'.encode("latin-1"))
     (root / "wide.toml").write_text('name = "wide"\nteams = [2, 2]\nwidth = 20000\nheight = 600\n')
+    (root / "crowd.toml").write_text('name = "crowd"\nteams = [3000, 3000]\n')
+    (root / "frac.toml").write_text('name = "frac"\nteams = [1.7, 2.9]\n')
+    (root / "big.toml").write_text("# " + "x" * (2 << 20) + '\nname = "big"\n')
     (root / "notgzip.replay.json.gz").write_bytes(b"plain text, not gzip")
     good = json.loads(gzip.decompress((root / "run" / "replays" / "last_round.replay.json.gz").read_bytes()))
     (root / "nokeys.replay.json").write_text(json.dumps({"format": "confront-replay/1", "width": 800}))
@@ -123,6 +126,16 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
     ("demo of 0 rounds", ["demo", "--rounds", "0"], "--rounds", None),
     ("config show with a bad override", ["config", "show", "demo", "--set", "learner.hidden=[-3]"],
      "learner.hidden[0]", None),
+    # issue 34 item 11: scenarios too big for memory, and team sizes that are not whole numbers
+    ("scenario of 6000 robots", ["train", "--set", "arena.scenario={ws}/crowd.toml", "--out", "{ws}/new"],
+     "at most 256", "new"),
+    ("battle of 6000 robots", ["battle", "--scenario", "{ws}/crowd.toml"], "at most 256", None),
+    ("scenario of 1.7 robots", ["train", "--set", "arena.scenario={ws}/frac.toml", "--out", "{ws}/new"],
+     "whole sizes", "new"),
+    # issue 34 item 12: files are read with a size limit
+    ("config show /dev/zero", ["config", "show", "/dev/zero"], "larger than 1 MB", None),
+    ("config of 2 MB", ["train", "-c", "{ws}/big.toml", "--out", "{ws}/new"], "larger than 1 MB", "new"),
+    ("scenario of 2 MB", ["battle", "--scenario", "{ws}/big.toml"], "larger than 1 MB", None),
     # issue 34 item 4: file systems that refuse (read-only, a name too long) are one line too
     ("read-only --out", ["train", *TINY, "--out", "/sys/confront-run", "--quiet"], "/sys/confront-run", None),
     ("--out name of 300 characters", ["train", *TINY, "--out", "{ws}/" + "r" * 300, "--quiet"], "too long", None),

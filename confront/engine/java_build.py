@@ -19,7 +19,9 @@ JAVA_SOURCES = Path(__file__).parent / "java"
 # Robot classes (package confront) and their robot.name entries for the .properties files.
 ROBOT_CLASSES: tuple[str, ...] = ("ScriptBot", "BridgeBot")
 # helper classes the robots load at run time, copied next to them
-ROBOT_HELPERS: tuple[str, ...] = ("RoundStart",)
+ROBOT_HELPERS: tuple[str, ...] = ("RoundStart", "RobotParts")
+# the model reader, MLP and gun/radar controller PolicyModel and TankModel share (no Robocode dependency)
+MODEL_CLASSES: tuple[str, ...] = ("ModelFile", "Mlp", "Aim")
 
 
 def cache_root() -> Path:

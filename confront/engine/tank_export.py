@@ -36,6 +36,7 @@ from confront.arena.rules import java_atan2, java_hypot
 from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
 from confront.engine.export import ROBOTS_FOLDER_HINT, ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
+from confront.engine.java_build import MODEL_CLASSES, ROBOT_HELPERS
 from confront.results import BattleResults
 
 Play = Literal["greedy", "sampled"]  # the most likely action, or one drawn from the policy
@@ -44,7 +45,7 @@ __all__ = ["TankPolicy", "PLAYS", "sample_heads", "robot_view", "robot_target", 
            "turn_rate", "export_tank_robot", "evaluate_tank_policy", "is_tank_run", "load_tank_policy", "TANK_CLASSES",
            "TANK_ROBOT"]
 
-TANK_CLASSES = ("TankBot", "TankModel", "RoundStart")
+TANK_CLASSES = ("TankBot", "TankModel", *MODEL_CLASSES, *ROBOT_HELPERS)
 TANK_ROBOT = "confront.TankBot 1.0"  # the exported jar's robot name
 EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time, turn rate
 MAX_RATE = math.pi / 18.0  # Rules.MAX_TURN_RATE, 10 deg/turn
@@ -294,7 +295,8 @@ def export_tank_robot(policy: TankPolicy, out: str | Path, install: EngineInstal
                       embed: bool = True) -> Path:
     """Write the standalone robot ``confront.TankBot`` with ``policy``: a robots folder or a ``.jar``.
 
-    It holds ``confront/TankBot.class``, ``TankModel.class``, ``RoundStart.class``, ``TankData.class`` (the policy
+    It holds ``confront/TankBot.class``, ``TankModel.class``, the classes it shares with PolicyBot
+    (:data:`TANK_CLASSES`), ``TankData.class`` (the policy
     as string constants, so the robot reads no file), ``TankBot.properties``, ``tank_policy.txt``, the team
     ``TankTeam.team`` (four TankBots: Robocode lists it as ``confront.TankTeam 1.0``) and the Java sources.
     ``embed=False`` leaves out TankData (no javac run: engine training): the robot then reads the file the JVM

@@ -8,11 +8,11 @@ from pathlib import Path
 
 from confront.engine.battle import TEAM_PACKAGE, Team
 from confront.engine.install import EngineInstall
-from confront.engine.java_build import ROBOT_CLASSES, ROBOT_HELPERS
+from confront.engine.java_build import MODEL_CLASSES, ROBOT_CLASSES, ROBOT_HELPERS
 
 SAMPLE_PACKAGES: tuple[str, ...] = ("sample", "sampleteam")
 # BridgeBot runs the exported robot's gun/radar controller (PolicyModel) between decisions
-BRIDGE_HELPERS: tuple[str, ...] = ("PolicyModel",)
+BRIDGE_HELPERS: tuple[str, ...] = ("PolicyModel", *MODEL_CLASSES)
 
 
 def prepare_workdir(

@@ -105,11 +105,8 @@ public class BridgeBot extends TeamRobot {
 
     @Override
     public void run() {
-        setAdjustGunForRobotTurn(true);
-        setAdjustRadarForRobotTurn(true);
-        setAdjustRadarForGunTurn(true);
         // the engine waits for this robot's first action; connecting first delays it past the engine's wait
-        RoundStart.awaitEngine();
+        RobotParts.start(this);
         connect();
         while (true) {
             long t0 = System.nanoTime();
@@ -282,19 +279,8 @@ public class BridgeBot extends TeamRobot {
         while (in.ready()) {
             update(in.readLine());
         }
-        int n = enemies.size();
-        double[] ex = new double[n];
-        double[] ey = new double[n];
-        double[] ee = new double[n];
-        int i = 0;
-        for (double[] v : enemies.values()) {
-            ex[i] = v[0];
-            ey[i] = v[1];
-            ee[i] = v[2];
-            i++;
-        }
-        int s = acting.moveState(getX(), getY(), getHeadingRadians(), ex, ey, getBattleFieldWidth(),
-                getBattleFieldHeight());
+        int s = acting.moveState(getX(), getY(), getHeadingRadians(), enemies.values().toArray(new double[0][]),
+                getBattleFieldWidth(), getBattleFieldHeight());
         while (unacked.size() >= MAX_UNACKED || behind(s) >= maxLag) {
             update(in.readLine());  // at most the socket's timeout, then the robot falls back
         }
@@ -504,20 +490,12 @@ public class BridgeBot extends TeamRobot {
      * energy now and at the previous record, for the paper's per-turn reward (Eq. 35) between decisions.
      */
     private void record() {
-        int n = enemies.size();
-        double[] ex = new double[n];
-        double[] ey = new double[n];
-        String[] names = new String[n];
+        String[] names = enemies.keySet().toArray(new String[0]);
         Map<String, Double> now = new HashMap<>();
-        int i = 0;
         for (Map.Entry<String, double[]> e : enemies.entrySet()) {
-            names[i] = e.getKey();
-            ex[i] = e.getValue()[0];
-            ey[i] = e.getValue()[1];
             now.put(e.getKey(), e.getValue()[2]);
-            i++;
         }
-        int t = PolicyModel.nearest(getX(), getY(), ex, ey);
+        int t = Aim.nearest(getX(), getY(), enemies.values().toArray(new double[0][]));
         if (history.length() > 0) {
             history.append('|');
         }
@@ -533,24 +511,8 @@ public class BridgeBot extends TeamRobot {
 
     /** The fixed gun/radar controller on the enemies' last scans, as PolicyBot runs it every turn. */
     private void control() {
-        int n = enemies.size();
-        double[] ex = new double[n];
-        double[] ey = new double[n];
-        int i = 0;
-        for (double[] v : enemies.values()) {
-            ex[i] = v[0];
-            ey[i] = v[1];
-            i++;
-        }
-        double[] g = controller.gunRadar(getX(), getY(), getGunHeadingRadians(), getRadarHeadingRadians(),
-                getGunHeat(), getEnergy(), ex, ey);
-        if (!Double.isNaN(g[0])) {
-            setTurnGunRightRadians(g[0]);
-        }
-        setTurnRadarRightRadians(g[1]);
-        if (g[2] > 0) {
-            setFire(g[2]);
-        }
+        RobotParts.command(this, controller.gunRadar(getX(), getY(), getGunHeadingRadians(),
+                getRadarHeadingRadians(), getGunHeat(), getEnergy(), enemies.values().toArray(new double[0][])));
     }
 
     private void send(String line) throws IOException {

@@ -482,27 +482,32 @@ public final class ConfrontRunner extends BattleAdaptor {
         }
     }
 
+    /** The score fields of a results row, in the order score() and current() give their values. */
+    private static final String[] SCORE_KEYS = {"total", "survival", "surv_bonus", "bullet_dmg", "bullet_bonus",
+        "ram_dmg", "ram_bonus"};
+
+    /** The battle's totals so far: the score fields, then the ranks (firsts, seconds, thirds). */
     private static void score(StringBuilder b, IScoreSnapshot s) {
-        b.append("{\"total\":").append(s.getTotalScore())
-                .append(",\"survival\":").append(s.getTotalSurvivalScore())
-                .append(",\"surv_bonus\":").append(s.getTotalLastSurvivorBonus())
-                .append(",\"bullet_dmg\":").append(s.getTotalBulletDamageScore())
-                .append(",\"bullet_bonus\":").append(s.getTotalBulletKillBonus())
-                .append(",\"ram_dmg\":").append(s.getTotalRammingDamageScore())
-                .append(",\"ram_bonus\":").append(s.getTotalRammingKillBonus())
-                .append(",\"firsts\":").append(s.getTotalFirsts())
-                .append(",\"seconds\":").append(s.getTotalSeconds())
+        fields(b, new double[] {s.getTotalScore(), s.getTotalSurvivalScore(), s.getTotalLastSurvivorBonus(),
+            s.getTotalBulletDamageScore(), s.getTotalBulletKillBonus(), s.getTotalRammingDamageScore(),
+            s.getTotalRammingKillBonus()});
+        b.append(",\"firsts\":").append(s.getTotalFirsts()).append(",\"seconds\":").append(s.getTotalSeconds())
                 .append(",\"thirds\":").append(s.getTotalThirds()).append('}');
     }
 
+    /** This round's score fields. */
     private static void current(StringBuilder b, IScoreSnapshot s) {
-        b.append("{\"total\":").append(s.getCurrentScore())
-                .append(",\"survival\":").append(s.getCurrentSurvivalScore())
-                .append(",\"surv_bonus\":").append(s.getCurrentSurvivalBonus())
-                .append(",\"bullet_dmg\":").append(s.getCurrentBulletDamageScore())
-                .append(",\"bullet_bonus\":").append(s.getCurrentBulletKillBonus())
-                .append(",\"ram_dmg\":").append(s.getCurrentRammingDamageScore())
-                .append(",\"ram_bonus\":").append(s.getCurrentRammingKillBonus()).append('}');
+        fields(b, new double[] {s.getCurrentScore(), s.getCurrentSurvivalScore(), s.getCurrentSurvivalBonus(),
+            s.getCurrentBulletDamageScore(), s.getCurrentBulletKillBonus(), s.getCurrentRammingDamageScore(),
+            s.getCurrentRammingKillBonus()});
+        b.append('}');
+    }
+
+    /** {"total":v0,"survival":v1,... of SCORE_KEYS (the object left open). */
+    private static void fields(StringBuilder b, double[] values) {
+        for (int i = 0; i < SCORE_KEYS.length; i++) {
+            b.append(i == 0 ? "{\"" : ",\"").append(SCORE_KEYS[i]).append("\":").append(values[i]);
+        }
     }
 
     private static void appendStrings(StringBuilder b, List<String> items) {

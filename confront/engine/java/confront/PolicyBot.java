@@ -1,11 +1,7 @@
 package confront;
 
 import java.io.IOException;
-import java.io.InputStream;
-import java.io.InputStreamReader;
 import java.io.Reader;
-import java.io.StringReader;
-import java.nio.charset.StandardCharsets;
 import java.util.HashSet;
 import java.util.LinkedHashMap;
 import java.util.Map;
@@ -18,8 +14,9 @@ import robocode.TeamRobot;
 
 /**
  * A trained policy exported from confront, running with no Python: reads its policy (compiled into
- * confront.PolicyData at export, so no file access is needed in the sandbox or from a jar), picks one of the paper's four moves every step_turns turns from the latest
- * scans of enemies (team-mates are ignored), and runs the fixed gun/radar controller every turn.
+ * confront.PolicyData at export, so no file access is needed in the sandbox or from a jar; else policy.txt beside
+ * the class), picks one of the paper's four moves every step_turns turns from the latest scans of enemies
+ * (team-mates are ignored), and runs the fixed gun/radar controller every turn.
  */
 public class PolicyBot extends TeamRobot {
     private final Map<String, double[]> enemies = new LinkedHashMap<>();
@@ -30,19 +27,13 @@ public class PolicyBot extends TeamRobot {
 
     @Override
     public void run() {
-        setAdjustGunForRobotTurn(true);
-        setAdjustRadarForRobotTurn(true);
-        setAdjustRadarForGunTurn(true);
-        RoundStart.awaitEngine();
+        RobotParts.start(this);
         PolicyModel model;
-        try {
-            model = load();
+        try (Reader r = RobotParts.embedded(this, "PolicyData", "policy.txt")) {
+            model = PolicyModel.read(r);
         } catch (IOException | RuntimeException e) {
-            out.println("CONFRONT policy-load-failed " + e);
-            while (true) {
-                setTurnRadarRightRadians(2 * Math.PI);
-                execute();
-            }
+            RobotParts.idle(this, "policy-load-failed", e);
+            return;
         }
         int step = model.stepTurns();
         if (getTeammates() != null) {
@@ -53,55 +44,19 @@ public class PolicyBot extends TeamRobot {
             }
         }
         while (true) {
-            double[][] e = known();
+            double[][] e = enemies.values().toArray(new double[0][]);
             long turn = getTime() + 1;  // the commands set now take effect in this turn
             if ((turn - 1) % step == 0) {
-                int a = model.act(getX(), getY(), getHeadingRadians(), getEnergy(), e[0], e[1], e[2],
-                        getBattleFieldWidth(), getBattleFieldHeight());
+                int a = model.act(getX(), getY(), getHeadingRadians(), getEnergy(), e, getBattleFieldWidth(),
+                        getBattleFieldHeight());
                 double[] mv = model.move(a);
                 setAhead(mv[0]);
                 setTurnRightRadians(mv[1]);
             }
-            double[] g = model.gunRadar(getX(), getY(), getGunHeadingRadians(), getRadarHeadingRadians(),
-                    getGunHeat(), getEnergy(), e[0], e[1]);
-            if (!Double.isNaN(g[0])) {
-                setTurnGunRightRadians(g[0]);
-            }
-            setTurnRadarRightRadians(g[1]);
-            if (g[2] > 0) {
-                setFire(g[2]);
-            }
+            RobotParts.command(this, model.gunRadar(getX(), getY(), getGunHeadingRadians(),
+                    getRadarHeadingRadians(), getGunHeat(), getEnergy(), e));
             execute();
         }
-    }
-
-    /** The policy compiled into confront.PolicyData (written at export), else policy.txt beside the class. */
-    private PolicyModel load() throws IOException {
-        try {
-            String[] chunks = (String[]) Class.forName("confront.PolicyData").getField("CHUNKS").get(null);
-            return PolicyModel.read(new StringReader(String.join("", chunks)));
-        } catch (ReflectiveOperationException e) {
-            InputStream res = getClass().getResourceAsStream("policy.txt");
-            if (res == null) {
-                throw new IOException("no confront.PolicyData class and no policy.txt");
-            }
-            try (Reader r = new InputStreamReader(res, StandardCharsets.UTF_8)) {
-                return PolicyModel.read(r);
-            }
-        }
-    }
-
-    private double[][] known() {
-        int n = enemies.size();
-        double[][] e = new double[3][n];
-        int i = 0;
-        for (double[] v : enemies.values()) {
-            e[0][i] = v[0];
-            e[1][i] = v[1];
-            e[2][i] = v[2];
-            i++;
-        }
-        return e;
     }
 
     @Override

@@ -31,26 +31,20 @@ public final class PolicyCheck {
             double energy = Double.parseDouble(h[9]);
             double heat = Double.parseDouble(h[10]);
             String[] scans = parts[1].isEmpty() ? new String[0] : parts[1].split("\\|");
+            double[][] enemies = new double[scans.length][];
             int n = 0;
-            double[] ex = new double[scans.length];
-            double[] ey = new double[scans.length];
-            double[] ee = new double[scans.length];
             for (String s : scans) {
                 String[] f = s.split(";");
                 if (f[2].equals("1")) {
                     continue;
                 }
-                ee[n] = Double.parseDouble(f[7]);
-                ex[n] = Double.parseDouble(f[8]);
-                ey[n] = Double.parseDouble(f[9]);
-                n++;
+                enemies[n++] = new double[] {Double.parseDouble(f[8]), Double.parseDouble(f[9]),
+                        Double.parseDouble(f[7])};
             }
-            ex = java.util.Arrays.copyOf(ex, n);
-            ey = java.util.Arrays.copyOf(ey, n);
-            ee = java.util.Arrays.copyOf(ee, n);
-            int a = m.act(x, y, heading, energy, ex, ey, ee, width, height);
-            double[] g = m.gunRadar(x, y, gunH, radarH, heat, energy, ex, ey);
-            int state = m.state(x, y, heading, PolicyModel.nearest(x, y, ex, ey), ex, ey, m.maxDistance(width, height));
+            enemies = java.util.Arrays.copyOf(enemies, n);
+            int a = m.act(x, y, heading, energy, enemies, width, height);
+            double[] g = m.gunRadar(x, y, gunH, radarH, heat, energy, enemies);
+            int state = m.moveState(x, y, heading, enemies, width, height);
             out.append(a).append(' ').append(g[0]).append(' ').append(g[1]).append(' ').append(g[2]).append(' ')
                     .append(state).append('\n');
         }

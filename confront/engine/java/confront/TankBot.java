@@ -4,11 +4,9 @@ import java.io.File;
 import java.io.FileInputStream;
 import java.io.FileOutputStream;
 import java.io.IOException;
-import java.io.InputStream;
 import java.io.InputStreamReader;
 import java.io.OutputStream;
 import java.io.Reader;
-import java.io.StringReader;
 import java.nio.charset.StandardCharsets;
 import java.util.HashSet;
 import java.util.LinkedHashMap;
@@ -61,19 +59,13 @@ public class TankBot extends TeamRobot {
 
     @Override
     public void run() {
-        setAdjustGunForRobotTurn(true);
-        setAdjustRadarForRobotTurn(true);
-        setAdjustRadarForGunTurn(true);
-        RoundStart.awaitEngine();
+        RobotParts.start(this);
         TankModel model;
-        try {
-            model = load();
+        try (Reader r = source()) {
+            model = TankModel.read(r);
         } catch (IOException | RuntimeException e) {
-            out.println("CONFRONT tank-load-failed " + e);
-            while (true) {
-                setTurnRadarRightRadians(2 * Math.PI);
-                execute();
-            }
+            RobotParts.idle(this, "tank-load-failed", e);
+            return;
         }
         String logDir = property(LOG_PROPERTY);
         detail = "true".equals(property(DETAIL_PROPERTY));
@@ -124,15 +116,9 @@ public class TankBot extends TeamRobot {
                     setAhead(a[0]);
                     setTurnRightRadians(model.bodyTurn(getX(), getY(), getHeadingRadians(), known, tgt, a[1]));
                 }
-                double[] g = model.control(getX(), getY(), getGunHeadingRadians(), getRadarHeadingRadians(),
-                        getGunHeat(), getEnergy(), known, tgt, power, lead, time, getBattleFieldWidth(),
-                        getBattleFieldHeight());
-                if (!Double.isNaN(g[0])) {
-                    setTurnGunRightRadians(g[0]);
-                }
-                setTurnRadarRightRadians(g[1]);
-                if (g[2] > 0) {
-                    setFire(g[2]);
+                if (RobotParts.command(this, model.control(getX(), getY(), getGunHeadingRadians(),
+                        getRadarHeadingRadians(), getGunHeat(), getEnergy(), known, tgt, power, lead, time,
+                        getBattleFieldWidth(), getBattleFieldHeight()))) {
                     shots++;
                 }
             } catch (RuntimeException e) {
@@ -226,25 +212,12 @@ public class TankBot extends TeamRobot {
 
     /** The policy file named by confront.tank.model, else the one compiled into confront.TankData (written at
      *  export), else tank_policy.txt beside the class. */
-    private TankModel load() throws IOException {
+    private Reader source() throws IOException {
         String path = property(MODEL_PROPERTY);
         if (path != null) {
-            try (Reader r = new InputStreamReader(new FileInputStream(path), StandardCharsets.UTF_8)) {
-                return TankModel.read(r);
-            }
+            return new InputStreamReader(new FileInputStream(path), StandardCharsets.UTF_8);
         }
-        try {
-            String[] chunks = (String[]) Class.forName("confront.TankData").getField("CHUNKS").get(null);
-            return TankModel.read(new StringReader(String.join("", chunks)));
-        } catch (ReflectiveOperationException e) {
-            InputStream res = getClass().getResourceAsStream("tank_policy.txt");
-            if (res == null) {
-                throw new IOException("no confront.TankData class and no tank_policy.txt");
-            }
-            try (Reader r = new InputStreamReader(res, StandardCharsets.UTF_8)) {
-                return TankModel.read(r);
-            }
-        }
+        return RobotParts.embedded(this, "TankData", "tank_policy.txt");
     }
 
     private void broadcast() {

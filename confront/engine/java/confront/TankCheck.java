@@ -20,16 +20,7 @@ import java.io.InputStreamReader;
  */
 public final class TankCheck {
     static double[] nums(String s) {
-        String t = s.trim();
-        if (t.isEmpty()) {
-            return new double[0];
-        }
-        String[] p = t.split(" ");
-        double[] a = new double[p.length];
-        for (int i = 0; i < p.length; i++) {
-            a[i] = Double.parseDouble(p[i]);
-        }
-        return a;
+        return ModelFile.numbers(s);
     }
 
     static double[][] rows(String s) {

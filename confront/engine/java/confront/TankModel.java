@@ -1,12 +1,7 @@
 package confront;
 
-import java.io.BufferedReader;
 import java.io.IOException;
 import java.io.Reader;
-import java.util.ArrayList;
-import java.util.HashMap;
-import java.util.List;
-import java.util.Map;
 
 /**
  * An exported tank policy (no Robocode dependency): the tank view of confront.arena.tank.tank_view_row, the
@@ -20,7 +15,6 @@ import java.util.Map;
  * are {x, y, energy}.
  */
 public final class TankModel {
-    static final double TWO_PI = 2 * Math.PI;
     static final int OWN = 11;
     static final int ENEMY = 9;
     static final int MATE = 5;
@@ -31,154 +25,58 @@ public final class TankModel {
     static final int LEAD_LINEAR = 1;
     static final int LEAD_CIRCULAR = 2;
 
-    final Map<String, String> keys = new HashMap<>();
-    final List<double[][]> weights = new ArrayList<>();
-    final List<double[]> biases = new ArrayList<>();
-    double[] distances;
-    double[] turns;  // radians
-    double[] powers;  // fire powers as given (0 = hold)
-    int enemySlots;
-    int mateSlots;
-    int stepTurns;
-    int[] leads;  // the lead head's choices: LEAD_NONE, LEAD_LINEAR, LEAD_CIRCULAR
-    boolean turnToTarget;  // turn_mode target: the body turn is an angle to the target's bearing
-    double overshoot;
-    double tolerance;
-    double powerNear;
-    double powerMid;
-    double powerFar;
-    double nearDistance;
-    double farDistance;
-    boolean fire;
-    boolean sampled;  // "play sampled": act draws each head from its softmax (sample), else greedy (act)
+    final Mlp actor;
+    final Aim aim;
+    final double[] distances;
+    final double[] turns;  // radians
+    final double[] powers;  // fire powers as given (0 = hold)
+    final int enemySlots;
+    final int mateSlots;
+    final int stepTurns;
+    final int[] leads;  // the lead head's choices: LEAD_NONE, LEAD_LINEAR, LEAD_CIRCULAR
+    final boolean turnToTarget;  // turn_mode target: the body turn is an angle to the target's bearing
+    final boolean sampled;  // "play sampled": act draws each head from its softmax (sample), else greedy (act)
 
-    /** Reads a "confront-tank 1" policy file. */
-    public static TankModel read(Reader source) throws IOException {
-        TankModel m = new TankModel();
-        BufferedReader r = new BufferedReader(source);
-        String first = r.readLine();
-        if (first == null || !first.equals("confront-tank 1")) {
-            throw new IOException("not a confront tank policy file (version 1): " + first);
-        }
-        String line;
-        while ((line = r.readLine()) != null) {
-            if (line.isEmpty() || line.startsWith("#")) {
-                continue;
-            }
-            String[] p = line.split(" ");
-            if (p[0].equals("matrix")) {
-                int rows = Integer.parseInt(p[2]);
-                int cols = Integer.parseInt(p[3]);
-                double[][] a = new double[rows][cols];
-                for (int i = 0; i < rows; i++) {
-                    String row = r.readLine();
-                    String[] v = row == null ? new String[0] : row.split(" ");
-                    if (v.length != cols) {
-                        throw new IOException("matrix " + p[1] + " row " + i + " has " + v.length + " values");
-                    }
-                    for (int j = 0; j < cols; j++) {
-                        a[i][j] = Double.parseDouble(v[j]);
-                    }
-                }
-                int layer = Integer.parseInt(p[1].substring(1));
-                if (p[1].startsWith("w") && layer == m.weights.size()) {
-                    m.weights.add(a);
-                } else if (p[1].startsWith("b") && layer == m.biases.size() && rows == 1) {
-                    m.biases.add(a[0]);
-                } else {
-                    throw new IOException("unexpected matrix " + p[1] + " " + rows + "x" + cols);
-                }
-            } else {
-                int sp = line.indexOf(' ');
-                m.keys.put(sp < 0 ? line : line.substring(0, sp), sp < 0 ? "" : line.substring(sp + 1));
-            }
-        }
-        m.distances = m.list("distances");
-        double[] deg = m.list("turns_deg");
-        m.turns = new double[deg.length];
+    private TankModel(ModelFile f) throws IOException {
+        distances = f.list("distances");
+        double[] deg = f.list("turns_deg");
+        turns = new double[deg.length];
         for (int i = 0; i < deg.length; i++) {
-            m.turns[i] = Math.toRadians(deg[i]);
+            turns[i] = Math.toRadians(deg[i]);
         }
-        m.powers = m.list("fire_powers");
-        m.enemySlots = (int) m.num("enemy_slots");
-        m.mateSlots = (int) m.num("mate_slots");
-        m.stepTurns = (int) m.num("step_turns");
-        String mode = m.keys.get("turn_mode");
-        if (!"target".equals(mode) && !"body".equals(mode)) {
-            throw new IOException("turn_mode must be target or body, got " + mode);
+        powers = f.list("fire_powers");
+        enemySlots = (int) f.num("enemy_slots");
+        mateSlots = (int) f.num("mate_slots");
+        stepTurns = (int) f.num("step_turns");
+        turnToTarget = "target".equals(f.choice("turn_mode", null, "target", "body"));
+        String[] names = f.text("leads", "").trim().split(" ");
+        leads = new int[names.length];
+        for (int i = 0; i < names.length; i++) {
+            leads[i] = lead(names[i]);
         }
-        m.turnToTarget = "target".equals(mode);
-        String[] leads = m.keys.getOrDefault("leads", "").trim().split(" ");
-        m.leads = new int[leads.length];
-        for (int i = 0; i < leads.length; i++) {
-            if ("none".equals(leads[i])) {
-                m.leads[i] = LEAD_NONE;
-            } else if ("linear".equals(leads[i])) {
-                m.leads[i] = LEAD_LINEAR;
-            } else if ("circular".equals(leads[i])) {
-                m.leads[i] = LEAD_CIRCULAR;
-            } else {
-                throw new IOException("leads must be none, linear or circular, got " + leads[i]);
-            }
-        }
-        m.overshoot = m.num("radar_overshoot");
-        m.tolerance = m.num("aim_tolerance");
-        m.powerNear = m.num("power_near");
-        m.powerMid = m.num("power_mid");
-        m.powerFar = m.num("power_far");
-        m.nearDistance = m.num("near_distance");
-        m.farDistance = m.num("far_distance");
-        m.fire = m.num("fire") != 0;
-        String play = m.keys.getOrDefault("play", "greedy");
-        if (!"greedy".equals(play) && !"sampled".equals(play)) {
-            throw new IOException("play must be greedy or sampled, got " + play);
-        }
-        m.sampled = "sampled".equals(play);
-        m.check();
-        return m;
-    }
-
-    private void check() throws IOException {
-        if (weights.isEmpty() || weights.size() != biases.size()) {
-            throw new IOException("the actor needs matrices w0, b0, w1, b1, ... (got " + weights.size()
-                    + " weights, " + biases.size() + " biases)");
-        }
-        int in = nFeatures();
-        for (int l = 0; l < weights.size(); l++) {
-            double[][] w = weights.get(l);
-            if (w.length == 0 || w[0].length != in || biases.get(l).length != w.length) {
-                throw new IOException("layer " + l + " does not chain from " + in + " inputs");
-            }
-            in = w.length;
-        }
+        aim = new Aim(f);
+        sampled = "sampled".equals(f.choice("play", "greedy", "greedy", "sampled"));
+        actor = f.mlp("tanh", "linear", 0.0, 0.0);
+        f.allTaken();
         int heads = 0;
         for (int n : dims()) {
             heads += n;
         }
-        if (in != heads) {
-            throw new IOException("the actor outputs " + in + " logits, the heads need " + heads);
+        actor.check(nFeatures(), heads);
+    }
+
+    private static int lead(String name) throws IOException {
+        switch (name) {
+            case "none": return LEAD_NONE;
+            case "linear": return LEAD_LINEAR;
+            case "circular": return LEAD_CIRCULAR;
+            default: throw new IOException("leads must be none, linear or circular, got " + name);
         }
     }
 
-    double num(String key) {
-        String v = keys.get(key);
-        if (v == null) {
-            throw new IllegalArgumentException("tank policy file lacks " + key);
-        }
-        return Double.parseDouble(v.trim());
-    }
-
-    double[] list(String key) {
-        String v = keys.get(key);
-        if (v == null || v.trim().isEmpty()) {
-            throw new IllegalArgumentException("tank policy file lacks " + key);
-        }
-        String[] p = v.trim().split(" ");
-        double[] a = new double[p.length];
-        for (int i = 0; i < p.length; i++) {
-            a[i] = Double.parseDouble(p[i]);
-        }
-        return a;
+    /** Reads a "confront-tank 1" policy file. */
+    public static TankModel read(Reader source) throws IOException {
+        return new TankModel(ModelFile.read(source, "confront-tank 1", "tank policy"));
     }
 
     public int stepTurns() {
@@ -222,22 +120,10 @@ public final class TankModel {
         }
         boolean[] used = new boolean[enemies.length];
         for (int s = 0; s < enemySlots; s++) {
-            int best = -1;
-            double bestD = Double.POSITIVE_INFINITY;
-            for (int j = 0; j < enemies.length; j++) {
-                if (used[j]) {
-                    continue;
-                }
-                double d = Math.hypot(enemies[j][0] - x, enemies[j][1] - y);
-                if (d < bestD) {
-                    best = j;
-                    bestD = d;
-                }
-            }
+            int best = nextNearest(x, y, enemies, used);
             if (best < 0) {
                 break;
             }
-            used[best] = true;
             if (s < slots.length) {
                 slots[s] = best;
             }
@@ -249,7 +135,7 @@ public final class TankModel {
             out[o] = 1.0;
             out[o + 1] = Math.sin(rel);
             out[o + 2] = Math.cos(rel);
-            out[o + 3] = Math.min(bestD / diag, 1.0);
+            out[o + 3] = Math.min(Math.hypot(e[0] - x, e[1] - y) / diag, 1.0);
             out[o + 4] = e[4] * Math.sin(relH) / 8.0;
             out[o + 5] = e[4] * Math.cos(relH) / 8.0;
             out[o + 6] = e[2] / 100.0;
@@ -258,31 +144,39 @@ public final class TankModel {
         }
         used = new boolean[mates.length];
         for (int s = 0; s < mateSlots; s++) {
-            int best = -1;
-            double bestD = Double.POSITIVE_INFINITY;
-            for (int j = 0; j < mates.length; j++) {
-                if (used[j]) {
-                    continue;
-                }
-                double d = Math.hypot(mates[j][0] - x, mates[j][1] - y);
-                if (d < bestD) {
-                    best = j;
-                    bestD = d;
-                }
-            }
+            int best = nextNearest(x, y, mates, used);
             if (best < 0) {
                 break;
             }
-            used[best] = true;
             int o = OWN + ENEMY * enemySlots + MATE * s;
             double rel = Math.atan2(mates[best][0] - x, mates[best][1] - y) - heading;
             out[o] = 1.0;
             out[o + 1] = Math.sin(rel);
             out[o + 2] = Math.cos(rel);
-            out[o + 3] = Math.min(bestD / diag, 1.0);
+            out[o + 3] = Math.min(Math.hypot(mates[best][0] - x, mates[best][1] - y) / diag, 1.0);
             out[o + 4] = mates[best][2] / 100.0;
         }
         return out;
+    }
+
+    /** The nearest row not used yet by distance (Math.hypot; first of equals), marked used; -1 if none. */
+    private static int nextNearest(double x, double y, double[][] rows, boolean[] used) {
+        int best = -1;
+        double bestD = Double.POSITIVE_INFINITY;
+        for (int j = 0; j < rows.length; j++) {
+            if (used[j]) {
+                continue;
+            }
+            double d = Math.hypot(rows[j][0] - x, rows[j][1] - y);
+            if (d < bestD) {
+                best = j;
+                bestD = d;
+            }
+        }
+        if (best >= 0) {
+            used[best] = true;
+        }
+        return best;
     }
 
     /** Actor logits for a view; the view is rounded to float32 first, as the simulator hands it to the learner. */
@@ -291,21 +185,7 @@ public final class TankModel {
         for (int i = 0; i < view.length; i++) {
             h[i] = (float) view[i];
         }
-        for (int l = 0; l < weights.size(); l++) {
-            double[][] w = weights.get(l);
-            double[] b = biases.get(l);
-            double[] o = new double[w.length];
-            boolean last = l == weights.size() - 1;
-            for (int i = 0; i < w.length; i++) {
-                double s = b[i];
-                for (int j = 0; j < h.length; j++) {
-                    s += w[i][j] * h[j];
-                }
-                o[i] = last ? s : Math.tanh(s);
-            }
-            h = o;
-        }
-        return h;
+        return actor.forward(h);
     }
 
     /** Greedy joint action (((d * nt + t) * nf + f) * K + k) * nl + l: the first maximum of each head's logits. */
@@ -425,7 +305,7 @@ public final class TankModel {
         if (!(dt > 0)) {
             return 0.0;
         }
-        double dh = relAngle(heading - prev[3]);
+        double dh = Aim.relAngle(heading - prev[3]);
         return Math.min(Math.max(dh / dt, -MAX_RATE), MAX_RATE);
     }
 
@@ -439,36 +319,12 @@ public final class TankModel {
             return turn;
         }
         double bearing = Math.atan2(enemies[tgt][0] - x, enemies[tgt][1] - y);
-        return relAngle(bearing + turn - heading);
+        return Aim.relAngle(bearing + turn - heading);
     }
 
     /** The row to aim at: chosen when it is a known enemy (>= 0), else the nearest known (first of equals), -1. */
     public static int target(double x, double y, double[][] enemies, int chosen) {
-        if (chosen >= 0 && chosen < enemies.length) {
-            return chosen;
-        }
-        int best = -1;
-        double bestD = Double.POSITIVE_INFINITY;
-        for (int j = 0; j < enemies.length; j++) {
-            double dx = enemies[j][0] - x;
-            double dy = enemies[j][1] - y;
-            double d = dx * dx + dy * dy;
-            if (d < bestD) {
-                best = j;
-                bestD = d;
-            }
-        }
-        return best;
-    }
-
-    /** Angle wrapped to [-pi, pi) as (a + pi) mod 2 pi - pi (numpy's float mod). */
-    static double relAngle(double a) {
-        double s = a + Math.PI;
-        double r = s % TWO_PI;  // fmod, as observe.float_mod
-        if (r < 0) {
-            r += TWO_PI;
-        }
-        return r - Math.PI;
+        return chosen >= 0 && chosen < enemies.length ? chosen : Aim.nearest(x, y, enemies);
     }
 
     /**
@@ -480,7 +336,7 @@ public final class TankModel {
                             double energy, double[][] enemies, int tgt, double power, int lead, double time,
                             double width, double height) {
         if (tgt < 0) {
-            return new double[] {Double.NaN, TWO_PI, 0.0};
+            return Aim.none();
         }
         double[] e = enemies[tgt];
         double tx = e[0];
@@ -492,26 +348,6 @@ public final class TankModel {
             tx = p[0];
             ty = p[1];
         }
-        double dx = tx - x;
-        double dy = ty - y;
-        double bearing = Math.atan2(dx, dy);
-        double dist = Math.hypot(dx, dy);
-        double gun = relAngle(bearing - gunHeading);
-        double radar = relAngle(bearing - radarHeading);
-        radar = radar + Math.signum(radar) * overshoot;
-        boolean shoot = Math.abs(gun) <= tolerance && gunHeat == 0 && energy > 0 && fire;
-        double p;
-        if (!shoot || power < 0) {
-            p = 0.0;
-        } else if (power > 0) {
-            p = power;
-        } else if (dist < nearDistance) {
-            p = powerNear;
-        } else if (dist < farDistance) {
-            p = powerMid;
-        } else {
-            p = powerFar;
-        }
-        return new double[] {gun, radar, p};
+        return aim.toward(x, y, tx, ty, gunHeading, radarHeading, gunHeat, energy, power);
     }
 }

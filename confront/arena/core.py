@@ -73,6 +73,7 @@ import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from functools import cache
+from numbers import Integral
 from typing import Any
 
 import numpy as np
@@ -117,6 +118,16 @@ def run_parallel(executor: ThreadPoolExecutor, fn: Callable[..., Any], calls: Se
     return out
 
 
+MAX_BATTLES = 1 << 16  # battles of one Arena
+
+
+def _whole(name: str, value: Any, lo: int, hi: int) -> int:
+    """``value`` as an int if it is a whole number (not a bool, not 2.5) in [lo, hi]; a ValueError naming it else."""
+    if isinstance(value, bool) or not isinstance(value, Integral) or not lo <= int(value) <= hi:
+        raise ValueError(f"{name} must be a whole number from {lo} to {hi}, got {str(value)[:40]}")
+    return int(value)
+
+
 def default_threads() -> int:
     """Threads for batched steps: CONFRONT_THREADS, else the CPUs this process may use."""
     env = os.environ.get("CONFRONT_THREADS")
@@ -138,10 +149,8 @@ class Arena:
             raise ValueError(f"order must be one of {sorted(ORDER_MODES)}, got {order!r}")
         self.scenario = scenario
         self.order = order
-        self.threads = default_threads() if threads is None else int(threads)
-        if self.threads < 1:
-            raise ValueError(f"threads must be >= 1, got {threads}")
-        self.state: ArenaState = allocate(scenario, int(n_battles))
+        self.threads = default_threads() if threads is None else _whole("threads", threads, 1, 4096)
+        self.state: ArenaState = allocate(scenario, _whole("n_battles", n_battles, 1, MAX_BATTLES))
         b, r = self.n_battles, self.n_robots
         self.params = np.array([scenario.width, scenario.height, scenario.gun_cooling_rate,
                                 scenario.inactivity_time, scenario.max_turns, scenario.turns_after_end,
@@ -172,8 +181,9 @@ class Arena:
         return self.state.n_robots
 
     def seed(self, seed: int) -> None:
-        """Seed every battle's java.util.Random with ``seed + b`` and start the battles."""
-        self.state.rng[:] = [java_seed(int(seed) + b) for b in range(self.n_battles)]
+        """Seed every battle's java.util.Random with ``seed + b`` (a Java long) and start the battles."""
+        seed = _whole("seed", seed, -(2**63), 2**63 - self.n_battles)
+        self.state.rng[:] = [java_seed(seed + b) for b in range(self.n_battles)]
         self._battle_start(np.arange(self.n_battles))
 
     def _battle_start(self, idx: np.ndarray) -> None:

@@ -81,16 +81,20 @@ class TeamParallelEnv(ParallelEnv):
 
     def step(self, actions: dict[str, Any]) -> tuple[dict[str, Any], dict[str, float], dict[str, bool],
                                                      dict[str, bool], dict[str, Any]]:
-        """Hold every live agent's action for T turns (agents missing from ``actions`` take action 0: forward,
-        or the first entry of every tank action head)."""
+        """Hold every live agent's action for T turns; ``actions`` must name every live agent (a missing one is a
+        ValueError, not a made-up action)."""
         self._actions[:] = 0
         for a, v in actions.items():
             if a not in self._index:
-                raise ValueError(f"unknown agent {a!r}")
+                raise ValueError(f"unknown agent {str(a)[:60]!r}")
             try:
                 self._actions[0, self._index[a]] = action_indices(self.config, v, 1)[0]
             except ValueError as err:
                 raise ValueError(f"action of {a}: {err}") from None
+        missing = [a for a in self.agents if a not in actions]
+        if missing:
+            raise ValueError(f"actions lack the live agents {', '.join(missing)}: give one action per agent of "
+                             "env.agents")
         drv = self._driver
         res = drv.env.step(drv.full_actions(self._actions, self._np_random))
         live = self.agents

@@ -228,3 +228,21 @@ def test_tank_view_pettingzoo_team_shares_the_score_margin() -> None:
     with pytest.raises(ValueError, match="action of tank_0: a tank action"):
         env.reset(seed=3)
         env.step({"tank_0": 7})
+
+
+def test_bad_api_arguments_are_refused_not_rounded() -> None:
+    """Issue 34 item 22: 2.5 battles, a seed beyond a Java long, a step that lacks an agent's action."""
+    from confront.arena.smdp import TeamBattleEnv
+
+    for bad in (2.5, True, 0, "2"):
+        with pytest.raises(ValueError, match="n_battles must be a whole number"):
+            TeamBattleEnv("1v1", n_battles=bad, opponents="SpinBot")  # type: ignore[arg-type]
+    env = TeamBattleEnv("1v1", n_battles=2, opponents="SpinBot")
+    for seed in (2**64, 2**63 - 1, 1.5):
+        with pytest.raises(ValueError, match="seed must be a whole number"):
+            env.reset(seed=seed)  # type: ignore[arg-type]
+    env.reset(seed=np.int64(2**63 - 2))  # the largest a battle pair can take
+    pz = parallel_env(scenario="4v4", opponents="SpinBot")
+    pz.reset(seed=0)
+    with pytest.raises(ValueError, match="actions lack the live agents tank_1, tank_2, tank_3"):
+        pz.step({"tank_0": 0})

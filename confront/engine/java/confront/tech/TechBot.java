@@ -19,8 +19,9 @@ import robocode.util.Utils;
  * (melee: used by every robot while more than one other robot is alive).
  *
  * Written so that the simulator's twin (confront/arena/tech.py) can follow it exactly: one decision per turn
- * in run() (event handlers only record), set* calls and execute(), radians, Math.atan2 / Math.hypot
- * (fdlibm, reproduced by the simulator), java.util.Random seeded from the first round's start position.
+ * in run() (event handlers only record), set* calls and execute(), radians, Math.atan2 / Math.hypot and
+ * StrictMath.sin / cos (fdlibm, reproduced by the simulator: Math.sin is a HotSpot intrinsic),
+ * java.util.Random seeded from the first round's start position.
  * What a robot learns (visit counts, hit statistics, gun hit rates, the generator) is kept in static fields:
  * the engine loads the class once per battle, so it lives for the battle's rounds.
  */
@@ -121,8 +122,8 @@ public abstract class TechBot extends TeamRobot {
         double b = getHeadingRadians() + e.getBearingRadians();
         eb[s] = b;
         ed[s] = e.getDistance();
-        ex[s] = getX() + Math.sin(b) * ed[s];
-        ey[s] = getY() + Math.cos(b) * ed[s];
+        ex[s] = getX() + StrictMath.sin(b) * ed[s];
+        ey[s] = getY() + StrictMath.cos(b) * ed[s];
         eh[s] = e.getHeadingRadians();
         ev[s] = e.getVelocity();
         ee[s] = e.getEnergy();
@@ -243,7 +244,7 @@ public abstract class TechBot extends TeamRobot {
         wt[w] = now - 1;
         ws[w] = 20 - 3 * fired;
         wa[w] = Math.atan2(prevX - wx[w], prevY - wy[w]);
-        wd[w] = prevV * Math.sin(prevH - wa[w]) >= 0 ? 1 : -1;
+        wd[w] = prevV * StrictMath.sin(prevH - wa[w]) >= 0 ? 1 : -1;
     }
 
     static double escape(double speed) {
@@ -291,7 +292,7 @@ public abstract class TechBot extends TeamRobot {
     double smooth(double px, double py, double a, double dir) {
         double w = getBattleFieldWidth(), h = getBattleFieldHeight();
         for (int k = 0; k < 60; k++) {
-            if (inField(px + Math.sin(a) * STICK, py + Math.cos(a) * STICK, w, h)) {
+            if (inField(px + StrictMath.sin(a) * STICK, py + StrictMath.cos(a) * STICK, w, h)) {
                 return a;
             }
             a += dir * 0.05;
@@ -339,7 +340,7 @@ public abstract class TechBot extends TeamRobot {
         }
         double a = orbitAngle(x, y, ex[t], ey[t], ed[t], moveDir);
         if (fired) {
-            if (rng.nextDouble() < 0.3 || !inField(x + Math.sin(a) * 80, y + Math.cos(a) * 80,
+            if (rng.nextDouble() < 0.3 || !inField(x + StrictMath.sin(a) * 80, y + StrictMath.cos(a) * 80,
                     getBattleFieldWidth(), getBattleFieldHeight())) {
                 moveDir = -moveDir;
                 a = orbitAngle(x, y, ex[t], ey[t], ed[t], moveDir);
@@ -398,7 +399,7 @@ public abstract class TechBot extends TeamRobot {
                 double goal = smooth(px, py, orbitAngle(px, py, wx[w], wy[w], dist, dir), dir);
                 double turn = Utils.normalRelativeAngle(goal - ph);
                 double ahead = 1;
-                if (Math.cos(turn) < 0) {
+                if (StrictMath.cos(turn) < 0) {
                     turn = Utils.normalRelativeAngle(turn + Math.PI);
                     ahead = -1;
                 }
@@ -408,8 +409,8 @@ public abstract class TechBot extends TeamRobot {
             } else {
                 pv = pv > 0 ? Math.max(0, pv - 2) : Math.min(0, pv + 2);
             }
-            px = Math.max(18, Math.min(fw - 18, px + Math.sin(ph) * pv));
-            py = Math.max(18, Math.min(fh - 18, py + Math.cos(ph) * pv));
+            px = Math.max(18, Math.min(fw - 18, px + StrictMath.sin(ph) * pv));
+            py = Math.max(18, Math.min(fh - 18, py + StrictMath.cos(ph) * pv));
             if (ws[w] * (now + k - wt[w]) > Math.hypot(px - wx[w], py - wy[w]) - 18) {
                 break;
             }
@@ -434,7 +435,7 @@ public abstract class TechBot extends TeamRobot {
             for (int k = 0; k < 10; k++) {
                 double a = rng.nextDouble() * TWO_PI;
                 double d = 80 + 120 * rng.nextDouble();
-                double px = x + Math.sin(a) * d, py = y + Math.cos(a) * d;
+                double px = x + StrictMath.sin(a) * d, py = y + StrictMath.cos(a) * d;
                 if (!inField(px, py, w - 15, h - 15) || px < 40 || py < 40) {
                     continue;
                 }
@@ -459,7 +460,7 @@ public abstract class TechBot extends TeamRobot {
             if (eAlive[k]) {
                 double dx = ex[k] - px, dy = ey[k] - py;
                 double d2 = Math.max(dx * dx + dy * dy, 1);
-                double along = 1 + Math.abs(Math.cos(toP - Math.atan2(ex[k] - x, ey[k] - y)));
+                double along = 1 + Math.abs(StrictMath.cos(toP - Math.atan2(ex[k] - x, ey[k] - y)));
                 r += (eMate[k] ? 50 : Math.min(ee[k], 100) + 20) * along / d2;
             }
         }
@@ -478,14 +479,14 @@ public abstract class TechBot extends TeamRobot {
                 break;
             }
             h += turnRate;
-            px = Math.max(18, Math.min(w - 18, px + Math.sin(h) * ev[t]));
-            py = Math.max(18, Math.min(fh - 18, py + Math.cos(h) * ev[t]));
+            px = Math.max(18, Math.min(w - 18, px + StrictMath.sin(h) * ev[t]));
+            py = Math.max(18, Math.min(fh - 18, py + StrictMath.cos(h) * ev[t]));
         }
         return Math.atan2(px - x, py - y);
     }
 
     int segment(int t) {
-        double lat = Math.abs(ev[t] * Math.sin(eh[t] - eb[t]));
+        double lat = Math.abs(ev[t] * StrictMath.sin(eh[t] - eb[t]));
         int ds = Math.min(4, (int) (ed[t] / 150));
         int ls = lat < 2 ? 0 : lat < 5.5 ? 1 : 2;
         boolean consecutive = ePrevScan[t] == eScan[t] - 1;
@@ -493,7 +494,7 @@ public abstract class TechBot extends TeamRobot {
         int as = a > 0 ? 2 : a < 0 ? 0 : 1;
         double s = ev[t] < 0 ? -1 : 1;
         int k = 0;
-        while (k < 15 && inField(ex[t] + Math.sin(eh[t]) * 20 * (k + 1) * s, ey[t] + Math.cos(eh[t]) * 20 * (k + 1) * s,
+        while (k < 15 && inField(ex[t] + StrictMath.sin(eh[t]) * 20 * (k + 1) * s, ey[t] + StrictMath.cos(eh[t]) * 20 * (k + 1) * s,
                 getBattleFieldWidth(), getBattleFieldHeight())) {
             k++;
         }
@@ -512,7 +513,7 @@ public abstract class TechBot extends TeamRobot {
         power = Math.min(power, ee[t] / 4 + 0.1);
         power = Math.max(0.1, power);
         double bs = 20 - 3 * power;
-        double lat = ev[t] * Math.sin(eh[t] - eb[t]);
+        double lat = ev[t] * StrictMath.sin(eh[t] - eb[t]);
         if (lat > 0) {
             gunDir = 1;
         } else if (lat < 0) {

@@ -286,16 +286,19 @@ def export(run: Path, out: Path, play: str | None) -> None:
               help="Seconds after which a battle's JVM is killed (default from rounds and robots).")
 @click.option("--out", type=click.Path(path_type=Path, file_okay=False), default=None,
               help="Output folder (resumable; default rumbles/<candidate>-<mode>).")
+@click.option("--one-cpu", is_flag=True, help="Each battle's JVM on one CPU of its own, C1 compiler only (faster on a "
+              "small machine; the engine's thread races may go the other way: docs/engine.md).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def rumble(candidate: str, folder: Path, mode: str, seeds: int, rounds: int | None, field: str | None,
            cpu_constant: float, team_size: int, workers: int | None, address: str | None, timeout: float | None,
-           out: Path | None, quiet: bool) -> None:
+           out: Path | None, one_cpu: bool, quiet: bool) -> None:
     """CANDIDATE (a trained run folder, a robot jar or a class such as sample.Tracker) against every robot of the
     jars in FOLDER, in the real engine: a table per opponent (APS, survival, bullet damage, 95% interval)."""
     from confront.experiments.rumble import rumble_cli
 
     rumble_cli(candidate, folder, mode=mode, seeds=seeds, rounds=rounds, field=field, cpu_constant=cpu_constant,
-               team_size=team_size, workers=workers, address=address, out=out, timeout=timeout, quiet=quiet)
+               team_size=team_size, workers=workers, address=address, out=out, timeout=timeout, one_cpu=one_cpu,
+               quiet=quiet)
 
 
 @cli.command()

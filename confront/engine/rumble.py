@@ -133,6 +133,7 @@ class BattleJob:
     cpu_constant_ms: float
     team_size: int
     timeout_s: float
+    one_cpu: bool = False  # the JVM on one claimed CPU, C1 only (confront.engine.affinity)
 
     def spec(self) -> BattleSpec:
         """The engine's battle: the candidate's side first."""
@@ -192,6 +193,7 @@ def play_job(job: BattleJob, jars: dict[str, bytes], install: Any = None) -> dic
 
     ``jars``: file name -> bytes of the jars the battle needs (sent along, so that a Ray worker on another machine
     needs no shared folder)."""
+    from confront.engine.affinity import claimed_cpu
     from confront.engine.install import find_engine
     from confront.engine.java_build import compile_java
     from confront.engine.runner import EngineOptions, java_command, run_process
@@ -212,10 +214,12 @@ def play_job(job: BattleJob, jars: dict[str, bytes], install: Any = None) -> dic
                              sorted((root / "jars").iterdir()))
         (root / "battle.battle").write_text(spec.battle_file())
         summary_file, log = root / "summary.json", root / "engine.log"
-        cmd = java_command(install, classes, wd, EngineOptions(seed=job.seed, cpu_constant_ms=job.cpu_constant_ms))
-        cmd += [str(wd), str(root / "battle.battle"), str(root / "results.txt"), str(summary_file)]
+        opts = EngineOptions(seed=job.seed, cpu_constant_ms=job.cpu_constant_ms)
+        args = [str(wd), str(root / "battle.battle"), str(root / "results.txt"), str(summary_file)]
         try:
-            code = run_process(cmd, job.timeout_s, root, log)
+            with claimed_cpu(job.one_cpu) as cpu:
+                cmd = java_command(install, classes, wd, opts, one_cpu=cpu is not None) + args
+                code = run_process(cmd, job.timeout_s, root, log, cpu=cpu)
         except TimeoutError:
             tail = " | ".join(ln for ln in log.read_text(errors="replace").splitlines()[-3:] if ln.strip())
             return {**result, "status": "timed out", "elapsed_s": time.time() - started,

@@ -55,6 +55,7 @@ class RumbleSettings:
     cpu_constant_ms: float = 10.0
     team_size: int = TEAM_SIZE
     timeout_s: float = 0.0  # 0: default_timeout_s
+    one_cpu: bool = False  # each battle's JVM on one claimed CPU with C1 only (EngineOptions.one_cpu)
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -139,7 +140,7 @@ def plan_jobs(candidate: Robot, opponents: Sequence[Robot], settings: RumbleSett
         n = s.team_size + sum(len(o.members) or s.team_size for o in group) if s.mode == "teams" else 1 + len(group)
         jobs.append(BattleJob(job_key(s.mode, group, seed), s.mode, candidate, group, seed, s.rounds, s.width,
                               s.height, s.cpu_constant_ms, s.team_size,
-                              s.timeout_s or default_timeout_s(s.rounds, n)))
+                              s.timeout_s or default_timeout_s(s.rounds, n), s.one_cpu))
     return jobs
 
 
@@ -318,13 +319,14 @@ def run_rumble(candidate: str, folder: str | os.PathLike[str], settings: RumbleS
 
 def rumble_cli(candidate: str, folder: Path, mode: str, seeds: int, rounds: int | None, field: str | None,
                cpu_constant: float, team_size: int, workers: int | None, address: str | None, out: Path | None,
-               timeout: float | None, quiet: bool) -> None:
+               timeout: float | None, one_cpu: bool, quiet: bool) -> None:
     """``confront rumble``: run, then print the Markdown table."""
     import click
 
     try:
         width, height = parse_field(field) if field else (0, 0)
-        settings = RumbleSettings(mode, seeds, rounds or 0, width, height, cpu_constant, team_size, timeout or 0.0)
+        settings = RumbleSettings(mode, seeds, rounds or 0, width, height, cpu_constant, team_size, timeout or 0.0,
+                                  one_cpu)
         if out is None:
             stem = Path(candidate).stem if candidate.endswith(".jar") or Path(candidate).is_dir() else candidate
             out = Path("rumbles") / (re.sub(r"[^\w.-]+", "_", stem) + f"-{mode}")

@@ -34,9 +34,10 @@ from . import _kernels as K
 from .bots import teammate_masks
 from .core import Arena
 from .rules import java_atan2, java_hypot, java_next_double, java_seed, normal_relative_angle
+from .scenarios import Scenario
 from .strictmath import strict_cos, strict_sin
 
-__all__ = ["TECH_ROBOTS", "TechBots", "tech_kind"]
+__all__ = ["TECH_ROBOTS", "TechBots", "tech_kind", "tech_battle"]
 
 G_HEAD, G_LINEAR, G_CIRCULAR, G_GF, G_VIRTUAL = range(5)
 MV_ORBIT, MV_STOPGO, MV_RAM, MV_SURF, MV_RISK = range(5)
@@ -590,11 +591,12 @@ def _decide(b, i, gun_kind, move_kind, m, st, rng, mates, rf, rb, ri, bi, kf, ki
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def tech_step(guns, moves, mem, stat, rng, mates, rf, rb, ri, bi, kf, ki, scanned, scan_order, cmd, w, h, hit_p,
               hit_h):
-    """One decision of every technique robot that is alive or died this turn (a dying robot's last wake: its
-    handlers and its run() loop run once more), in every battle (cmd rows: NaN = keep)."""
+    """One decision of every alive technique robot in every battle (cmd rows: NaN = keep). A robot that died
+    decides nothing more: the Java robot's onDeath stops its decisions (its last wake handles the turn's events
+    only)."""
     for b in range(rf.shape[0]):
         for i in range(rf.shape[2]):
-            if guns[i] >= 0 and (rb[b, K.ALIVE, i] or rb[b, K.EVDIED, i]):
+            if guns[i] >= 0 and rb[b, K.ALIVE, i]:
                 _decide(b, i, guns[i], moves[i], mem[b, i], stat[b, i], rng, mates[i], rf, rb, ri, bi, kf, ki,
                         scanned, scan_order, cmd[b, i], w, h, hit_p, hit_h)
 
@@ -658,3 +660,46 @@ class TechBots:
                   *self._hits)
         return cmd
 
+
+
+def tech_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 1, scenario: Scenario | None = None,
+                rounds_per_battle: int = 35, turns_after_end: int = 150) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """Technique robots and sample robots (one name per robot) over ``rounds`` rounds, as
+    :func:`confront.arena.bots.bot_battle` plays sample robots: a free-for-all by default, the rounds spread over
+    ``n_battles`` parallel battles (battle b seeded ``seed + b``; with one battle and the engine's seed, the
+    engine's start positions and processing order). Each battle keeps its robots' battle memory for
+    ``rounds_per_battle`` rounds. Returns the score parts (R, 6) and placements (R, 3) summed over the rounds, and
+    the rounds' lengths in turns (battle 0's first)."""
+    from .bots import BOT_NAMES, ScriptedBots
+    from .scenarios import get_scenario
+
+    if rounds < 1:
+        raise ValueError(f"rounds must be >= 1, got {rounds}")
+    for n in names:
+        if n not in TECH_ROBOTS and n not in BOT_NAMES:
+            raise ValueError(f"unknown robot {n!r}; known: {', '.join((*TECH_ROBOTS, *BOT_NAMES))}")
+    n_battles = min(n_battles, rounds)
+    base = scenario if scenario is not None else get_scenario("melee").replace(teams=tuple(1 for _ in names))
+    if base.n_robots != len(names):
+        raise ValueError(f"scenario {base.name} has {base.n_robots} robots, got {len(names)} names")
+    arena = Arena(base.replace(turns_after_end=turns_after_end, max_turns=100000), n_battles, seed=seed)
+    samples = ScriptedBots(arena, [n if n in BOT_NAMES else None for n in names])
+    tech = TechBots(arena, [n if n in TECH_ROBOTS else None for n in names], rounds_per_battle)
+    quota = np.full(n_battles, rounds // n_battles)
+    quota[: rounds % n_battles] += 1
+    played = np.zeros(n_battles, dtype=np.int64)
+    cmd = arena.idle_commands()
+    s = arena.state
+    lengths: list[int] = []
+    while (played < quota).any():
+        samples.commands(cmd)
+        tech.commands(cmd)
+        arena.step(cmd)
+        done = s.done.copy()
+        if done.any():
+            lengths += [int(t) for t in s.time[done]]
+            played += done
+            again = done & (played < quota)
+            if again.any():
+                arena.reset(again)
+    return s.score_total.sum(axis=0), s.placements_total.sum(axis=0), lengths

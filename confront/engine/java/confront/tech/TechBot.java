@@ -3,6 +3,7 @@ package confront.tech;
 import java.util.Random;
 
 import robocode.BulletHitEvent;
+import robocode.DeathEvent;
 import robocode.HitByBulletEvent;
 import robocode.RobotDeathEvent;
 import robocode.ScannedRobotEvent;
@@ -69,6 +70,9 @@ public abstract class TechBot extends TeamRobot {
     double moveDir = 1, gunDir = 1, destX = -1, destY = -1;
     long destTime;
     double prevX, prevY, prevH, prevV;
+    // set by onDeath: a dead robot decides nothing more (the engine may still wake it, e.g. when a bullet it fired
+    // hits after its death and gives it energy: a race between the battle thread and the robot's)
+    boolean dead;
 
     protected TechBot(int gunKind, int moveKind) {
         this.gunKind = gunKind;
@@ -87,7 +91,9 @@ public abstract class TechBot extends TeamRobot {
         }
         setTurnRadarRightRadians(SPIN);
         while (true) {
-            decide();
+            if (!dead) {
+                decide();
+            }
             nHit = 0;
             myHitDamage = 0;
             execute();
@@ -130,6 +136,11 @@ public abstract class TechBot extends TeamRobot {
         eScan[s] = getTime();
         eAlive[s] = true;
         eMate[s] = isTeammate(e.getName());
+    }
+
+    @Override
+    public void onDeath(DeathEvent e) {
+        dead = true;
     }
 
     @Override

@@ -101,3 +101,40 @@ def test_play_rejects_bad_arguments():
         bots.play(-1)
     with pytest.raises(ValueError, match="cmd"):
         bots.play(3, np.zeros((2, 2, 4)))
+
+
+# tech_battle(names, rounds=6, seed, n_battles=3, scenario): the technique robots' twins (confront.arena.tech, engine
+# traces in tests/fixtures/traces/tech) with sample robots, in a melee and as teams of four; recorded with the
+# simulator (2026-12-05)
+TECH_RECORDED = {
+    "surfvg_spinbot": (["SurfVG", "SpinBot"], None, 4,
+                       [[300.0, 60.0, 563.4, 113.28000000000002, 6.0, 0.0], [0.0, 0.0, 32.0, 0.0, 1.2, 0.0]],
+                       [[6, 0, 0], [0, 6, 0]]),
+    "tech_melee": (["RiskGF", "OrbitGF", "SurfGF", "StopGoCircular"], None, 5,
+                   [[550.0, 90.0, 357.81025140176934, 34.44464365930324, 0.0, 0.0],
+                    [500.0, 60.0, 276.8185511274886, 21.276318453026768, 0.0, 0.0],
+                    [300.0, 0.0, 284.2753833820735, 20.835342824155312, 0.0, 0.0],
+                    [450.0, 30.0, 267.15955079930256, 15.616856458254556, 0.0, 0.0]],
+                   [[3, 0, 2], [2, 1, 2], [0, 3, 0], [1, 2, 2]]),
+    "tech_4v4": (["RiskGF"] * 4 + ["OrbitVG"] * 4, "4v4", 6,
+                 [[1200.0, 240.0, 375.9017711126679, 81.53373713044213, 4.8, 0.0],
+                  [1000.0, 160.0, 416.40060208193745, 57.27861052290908, 8.4, 0.0],
+                  [750.0, 120.0, 496.4586442709343, 78.66957246807648, 61.200000000000045, 0.0],
+                  [1100.0, 200.0, 379.95436242581457, 92.11969440867226, 0.0, 0.0],
+                  [300.0, 0.0, 339.6886155720895, 18.080000000000002, 54.00000000000004, 0.0],
+                  [100.0, 0.0, 98.97783787743978, 0.0, 0.0, 0.0],
+                  [150.0, 0.0, 196.44305298271152, 15.976227678118347, 0.0, 0.0],
+                  [200.0, 0.0, 170.40834611946292, 10.493976544391671, 20.4, 14.951975088622655]],
+                 [[6, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 3, 0], [0, 1, 0], [0, 1, 0], [0, 1, 0]]),
+}
+
+
+@pytest.mark.parametrize("key", sorted(TECH_RECORDED))
+def test_technique_robot_results_are_unchanged(key):
+    from confront.arena.tech import tech_battle
+
+    names, scenario, seed, parts, placements = TECH_RECORDED[key]
+    sc = get_scenario(scenario) if scenario else None
+    got_parts, got_pl, _ = tech_battle(names, rounds=6, seed=seed, n_battles=3, scenario=sc)
+    np.testing.assert_array_equal(got_pl, np.array(placements))
+    np.testing.assert_allclose(got_parts, np.array(parts), rtol=0, atol=1e-9)

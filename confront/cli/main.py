@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -20,6 +21,7 @@ EXTRAS = {"ray": "distributed", "pyarrow": "parquet", "stable_baselines3": "base
 SEED = click.IntRange(0, 2**32 - 1)
 COUNT = click.IntRange(min=1)
 ROUNDS = click.IntRange(1, 2**31 - 1)  # Robocode's numRounds is a Java int
+ROBOCODE_CRASH = re.compile(rb"Exception in thread \"main\" [\w.$]+|java\.awt\.(AWTError|HeadlessException)")
 
 
 def _one_line(text: str) -> str:
@@ -243,11 +245,15 @@ def robocode(robots: tuple[Path, ...], workdir: Path | None) -> None:
         except ValueError as err:
             raise click.UsageError(str(err)) from None
     wd = robocode_workdir(install, workdir)
+    log = wd / "confront-robocode.log"
     click.echo(f"Robocode (working directory {wd}; {len(jars)} robot jar(s) copied into its robots folder): "
                "close its window to return")
     proc.wait()
+    crashed = ROBOCODE_CRASH.search(log.read_bytes()[-(1 << 20):]) if log.is_file() else None
     if proc.returncode != 0:
-        raise click.ClickException(f"Robocode exited with code {proc.returncode} (see {wd}/confront-robocode.log)")
+        raise click.ClickException(f"Robocode exited with code {proc.returncode} (see {log})")
+    if crashed:  # Robocode exits 0 after an uncaught exception of its window
+        raise click.ClickException(f"Robocode failed ({crashed.group(0).decode()}; see {log})")
 
 
 @cli.command()

@@ -29,9 +29,14 @@ def default_workdir() -> Path:
 def robocode_workdir(install: EngineInstall, path: Path | None = None) -> Path:
     """``path`` (default :func:`default_workdir`), made as Debian's launcher makes it when it does not exist:
     the installation's folders copied (sample robots included), mode 700."""
-    wd = Path(path) if path is not None else default_workdir()
-    if wd.is_dir():
+    wd = Path(path).absolute() if path is not None else default_workdir()  # Robocode resolves from its own cwd
+    if wd.is_dir() and (wd / "robots").is_dir():
         return wd
+    if wd.is_dir() and any(wd.iterdir()):
+        raise ValueError(f"--workdir {wd} is not a Robocode working directory (it has no robots folder): give a "
+                         "new or empty folder, or one Robocode made")
+    if wd.is_dir():
+        wd.rmdir()  # an empty folder: made as a new one
     share = install.samples.parent
     tmp = wd.with_name(f".{wd.name}.{os.getpid()}.tmp")
     tmp.mkdir(mode=0o700, parents=True)

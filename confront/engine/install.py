@@ -24,10 +24,20 @@ JVM_FLAGS: tuple[str, ...] = (
 )
 
 
+X11_SOCKETS = Path("/tmp/.X11-unix")  # where a local X server ":N" listens (X<N>)
+
+
 def require_display(what: str) -> None:
-    """ValueError naming ``what`` when no display is set: Robocode's windows need one."""
-    if not os.environ.get("DISPLAY"):
+    """ValueError naming ``what`` when no display is set, or when ``DISPLAY`` names a local display (``:N``) whose
+    X server is not running (no socket): Robocode's windows need one."""
+    display = os.environ.get("DISPLAY")
+    if not display:
         raise ValueError(f"{what} needs a display, and DISPLAY is not set (run it on a desktop, or under xvfb-run)")
+    host, _, rest = display.rpartition(":")
+    number = rest.split(".")[0]
+    if host in ("", "unix") and number.isdigit() and not (X11_SOCKETS / f"X{number}").exists():
+        raise ValueError(f"{what} needs a display, and no X server runs on DISPLAY={display[:40]} (no "
+                         f"{X11_SOCKETS}/X{number}): start one, or run under xvfb-run")
 
 
 class EngineNotFoundError(RuntimeError):

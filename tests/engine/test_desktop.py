@@ -80,6 +80,53 @@ def test_robocode_command_refuses_without_a_display_or_a_jar(monkeypatch: pytest
     assert res.exit_code == 2 and "Robocode's window needs a display, and DISPLAY is not set" in res.output
     assert not (tmp_path / "wd").exists()  # nothing made before the check
     monkeypatch.setenv("DISPLAY", ":12345")
+    monkeypatch.setattr("confront.engine.install.require_display", lambda what: None)  # as if it had an X server
+    monkeypatch.setattr("confront.engine.desktop.require_display", lambda what: None)
     (tmp_path / "policy.txt").write_text("not a jar")
     res = CliRunner().invoke(cli, ["robocode", str(tmp_path / "policy.txt"), "--workdir", str(tmp_path / "wd")])
     assert res.exit_code == 2 and "is not a robot jar: write one with confront export RUN --out NAME.jar" in res.output
+
+
+def test_a_display_without_an_x_server_is_refused(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Issue 34 item 8: DISPLAY=:N with no X server on it was started (Robocode crashed, exit 0)."""
+    number = next(n for n in range(987, 1100) if not Path(f"/tmp/.X11-unix/X{n}").exists())
+    monkeypatch.setenv("DISPLAY", f":{number}")
+    res = CliRunner().invoke(cli, ["robocode", "--workdir", str(tmp_path / "wd")])
+    assert res.exit_code == 2 and f"no X server runs on DISPLAY=:{number}" in res.stderr, res.output
+    assert len(res.stderr.strip().splitlines()) == 1 and not (tmp_path / "wd").exists()
+
+
+def test_robocode_that_crashes_with_exit_0_is_a_failure(install: EngineInstall, monkeypatch: pytest.MonkeyPatch,
+                                                        tmp_path: Path) -> None:
+    """Issue 34 item 8: Robocode's window failing (an AWTError in its log) while it exits 0 is reported."""
+    import confront.engine.desktop as desktop
+
+    wd = robocode_workdir(install, tmp_path / "wd")
+
+    def crashing(install: EngineInstall, jars: list[Path], workdir: Path | None, wait: bool) -> subprocess.Popen:
+        (wd / "confront-robocode.log").write_text('Exception in thread "main" java.awt.AWTError: Can\'t connect\n')
+        return subprocess.Popen(["true"])
+
+    monkeypatch.setattr("confront.engine.install.require_display", lambda what: None)
+    monkeypatch.setattr(desktop, "open_robocode", crashing)
+    res = CliRunner().invoke(cli, ["robocode", "--workdir", str(wd)])
+    assert res.exit_code == 1 and "java.awt.AWTError" in res.output and "Robocode failed" in res.output, res.output
+
+
+def test_workdir_relative_or_without_robots_folder(install: EngineInstall, monkeypatch: pytest.MonkeyPatch,
+                                                  tmp_path: Path) -> None:
+    """Issue 34 item 9: a relative --workdir is made absolute (Robocode looked in rel/rel); a folder of other
+    things without robots/ is refused in one line; an empty one is made a working directory."""
+    monkeypatch.chdir(tmp_path)
+    wd = robocode_workdir(install, Path("rel"))
+    assert wd == tmp_path / "rel" and (wd / "robots" / "sample").is_dir()
+    assert f"-DWORKINGDIRECTORY={tmp_path / 'rel'}" in robocode_command(install, wd)
+    (tmp_path / "empty").mkdir()
+    assert (robocode_workdir(install, Path("empty")) / "robots").is_dir()
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "mine.txt").write_text("m")
+    monkeypatch.setattr("confront.engine.install.require_display", lambda what: None)
+    monkeypatch.setattr("confront.engine.desktop.require_display", lambda what: None)
+    res = CliRunner().invoke(cli, ["robocode", "--workdir", "other"])
+    assert res.exit_code == 2 and "is not a Robocode working directory" in res.stderr, res.output
+    assert sorted(p.name for p in (tmp_path / "other").iterdir()) == ["mine.txt"]

@@ -23,6 +23,7 @@ import json
 import math
 import re
 import tempfile
+import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
@@ -50,6 +51,7 @@ TANK_ROBOT = "confront.TankBot 1.0"  # the exported jar's robot name
 EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time, turn rate
 MAX_RATE = math.pi / 18.0  # Rules.MAX_TURN_RATE, 10 deg/turn
 MateRow = Sequence[float]  # x, y, energy
+MAX_STEP_TURNS = 500  # turns a decision is held (the configs' tank.decision_turns bound)
 PLAYS = ("greedy", "sampled")  # TankPolicy.play: the first maximum of each head, or a draw from its softmax
 
 
@@ -201,8 +203,10 @@ class TankPolicy:
     def __post_init__(self) -> None:
         if self.play not in PLAYS:
             raise ValueError(f"play must be one of {', '.join(PLAYS)}, got {self.play!r}")
-        if not isinstance(self.step_turns, int) or self.step_turns < 1:
-            raise ValueError(f"step_turns must be an integer >= 1, got {self.step_turns!r}")
+        if isinstance(self.step_turns, bool) or not isinstance(self.step_turns, int) \
+                or not 1 <= self.step_turns <= MAX_STEP_TURNS:
+            raise ValueError(f"step_turns must be a whole number from 1 to {MAX_STEP_TURNS}, got "
+                             f"{str(self.step_turns)[:40]}")
         if not self.weights or len(self.weights) != len(self.biases):
             raise ValueError("the actor needs as many weight matrices as bias vectors (at least one)")
         n_in = self.space.n_features
@@ -348,9 +352,28 @@ def is_tank_run(run: str | Path) -> bool:
 
 
 def load_tank_policy(run: str | Path, play: Play = "greedy") -> TankPolicy:
-    """The policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``, playing ``play``."""
+    """The policy of a PPO run (or model folder): ``actor.npz`` and ``tank.json``, playing ``play``. Files that
+    are missing give a FileNotFoundError, files that are corrupt or do not fit (a hand-edited ``tank.json``, a
+    truncated ``actor.npz``, NaN weights, a step of 1e30 turns) a CheckpointError naming the folder."""
+    from confront.checkpoint import CheckpointError
+
     folder = _model_dir(run)
-    cfg = json.loads((folder / "tank.json").read_text(encoding="utf-8"))
+    try:
+        return _read_tank_policy(folder, play)
+    except FileNotFoundError as exc:
+        raise FileNotFoundError(f"no trained tank model in {run} (its {Path(exc.filename or '').name} is missing)"
+                                ) from None
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, EOFError, RecursionError,
+            zipfile.BadZipFile) as exc:  # JSON, Unicode and numpy errors are ValueErrors
+        why = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise CheckpointError(f"model {folder} cannot be used: {why}") from None
+
+
+def _read_tank_policy(folder: Path, play: Play) -> TankPolicy:
+    with (folder / "tank.json").open("rb") as fh:
+        cfg = json.loads(fh.read(1 << 20))
+    if not isinstance(cfg, dict):
+        raise ValueError("tank.json is not a table")
     tank_cfg = cfg.get("tank", cfg)
     names = {f.name for f in fields(TankSpace)}
     given: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v for k, v in tank_cfg.items() if k in names}
@@ -359,9 +382,11 @@ def load_tank_policy(run: str | Path, play: Play = "greedy") -> TankPolicy:
     control = ControlConfig(**{f.name: ctl_cfg[f.name] for f in fields(ControlConfig) if f.name in ctl_cfg})
     step = cfg.get("step_turns", cfg.get("turns_per_step"))
     if step is None:
-        raise ValueError(f"{folder / 'tank.json'} lacks step_turns")
+        raise ValueError("tank.json lacks step_turns")
+    if isinstance(step, bool) or not isinstance(step, int):
+        raise ValueError(f"tank.json's step_turns must be a whole number of turns, got {str(step)[:40]}")
     if "dims" in cfg and tuple(cfg["dims"]) != space.dims:
-        raise ValueError(f"{folder / 'tank.json'}: dims {cfg['dims']} do not match the action heads {space.dims}")
+        raise ValueError(f"tank.json: dims {str(cfg['dims'])[:60]} do not match the action heads {space.dims}")
     with np.load(folder / "actor.npz", allow_pickle=False) as z:
         state = {k: z[k] for k in z.files}
     return replace(TankPolicy.from_state(state, space, control, int(step)), play=play)

@@ -99,10 +99,22 @@ def save_learner(path: str | Path, learner: Learner) -> Path:
 
 
 def load_learner(path: str | Path, frozen: bool | None = None) -> Learner:
-    """Read a learner saved by :func:`save_learner`; ``frozen`` overrides whether it keeps learning."""
+    """Read a learner saved by :func:`save_learner`; ``frozen`` overrides whether it keeps learning. A file whose
+    metadata does not fit its arrays (say hidden layers far larger than the weights it holds), or whose arrays
+    hold NaN or infinite values, is a ValueError: nothing is allocated for it, nothing plays it."""
     with np.load(path, allow_pickle=False) as data:
         meta = json.loads(str(data["__meta__"]))
         state = {k: data[k] for k in data.files if k != "__meta__"}
+    if not isinstance(meta, dict) or not isinstance(meta.get("params"), dict) or not isinstance(meta.get("kind"), str):
+        raise ValueError("its metadata is not a learner's (kind, params)")
+    hidden = meta["params"].get("hidden")
+    if isinstance(hidden, list) and all(isinstance(h, int) for h in hidden):
+        weights = sum(a * b for a, b in zip(hidden, hidden[1:], strict=False)) + sum(hidden)
+        if weights > sum(a.size for a in state.values()):  # the arrays could not hold such layers
+            raise ValueError(f"hidden layers {str(hidden)[:60]} do not fit the {len(state)} arrays it holds")
+    bad = [k for k, a in state.items() if a.dtype.kind in "fc" and not np.all(np.isfinite(a))]
+    if bad:
+        raise ValueError(f"its arrays {', '.join(bad[:5])} hold NaN or infinite values")
     learner = make_learner(meta["kind"], fuzzy=meta["fuzzy"], **meta["params"])
     learner.load_state_dict(state)
     if frozen if frozen is not None else meta["frozen"]:

@@ -10,8 +10,11 @@ import json
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -44,6 +47,12 @@ def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
     shutil.copytree(root / "run", root / "truncated")
     npz = root / "truncated" / "model" / "learner.npz"
     npz.write_bytes(npz.read_bytes()[:100])
+    _edit_learner(root, "nanmodel", lambda meta, state: (meta, {k: np.full_like(v, np.nan) if v.dtype.kind == "f"
+                                                                  else v for k, v in state.items()}))
+    _edit_learner(root, "hugemodel", lambda meta, state: ({**meta, "params": {**meta["params"],
+                                                                                "hidden": [100000, 100000]}}, state))
+    for name, edit in TANK_EDITS.items():
+        _tank_model(root / name, edit)
     (root / "afile").write_text("not a folder\n")
     (root / "adir").mkdir()
     (root / "latin1.toml").write_bytes('name = "d\xe9mo"\n'.encode("latin-1"))
@@ -60,6 +69,52 @@ def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (root / "bomb.replay.json.gz").write_bytes(gzip.compress(b" " * (65 << 20)))
     (root / "grid.toml").write_text('experiment = "demo"\nseeds = 1\n')
     return root
+
+
+def _edit_learner(root: Path, name: str, edit: Any) -> None:
+    """A copy of the trained run whose model/learner.npz went through ``edit(meta, state)``."""
+    shutil.copytree(root / "run", root / name)
+    path = root / name / "model" / "learner.npz"
+    with np.load(path, allow_pickle=False) as z:
+        meta, state = json.loads(str(z["__meta__"])), {k: z[k] for k in z.files if k != "__meta__"}
+    meta, state = edit(meta, state)
+    with path.open("wb") as fh:
+        np.savez(fh, __meta__=np.array(json.dumps(meta)), **state)
+
+
+TANK_EDITS: dict[str, Any] = {  # PPO model folders written by hand: tank.json and actor.npz edited
+    "tank-step": lambda tank, actor: ({**tank, "step_turns": 1e30}, actor),
+    "tank-json": lambda tank, actor: ("[1, 2", actor),
+    "tank-nan": lambda tank, actor: (tank, {k: np.full_like(v, np.nan) for k, v in actor.items()}),
+    "tank-wrong": lambda tank, actor: (tank, {**actor, "w0": actor["w0"][:, :7]}),
+    "tank-truncated": lambda tank, actor: (tank, None),
+}
+
+
+def _tank_model(folder: Path, edit: Any) -> None:
+    from confront.arena.tank import TankSpace
+
+    space = TankSpace()
+    rng = np.random.default_rng(0)
+    actor = {"w0": rng.normal(size=(sum(space.dims), space.n_features)), "b0": np.zeros(sum(space.dims))}
+    tank, actor = edit({"step_turns": 5}, actor)
+    model = folder / "model"
+    model.mkdir(parents=True)
+    (model / "model.json").write_text(json.dumps({"format": "confront-model/1", "kind": "ppo"}))
+    (model / "tank.json").write_text(tank if isinstance(tank, str) else json.dumps(tank))
+    with (model / "actor.npz").open("wb") as fh:
+        np.savez(fh, **(actor if actor is not None else {"w0": np.zeros(3)}))
+    if actor is None:
+        (model / "actor.npz").write_bytes((model / "actor.npz").read_bytes()[:60])
+
+
+def test_a_hand_written_tank_model_loads() -> None:
+    """The control of the tank-* cases: the same files unedited make a policy."""
+    from confront.engine.tank_export import load_tank_policy
+
+    with tempfile.TemporaryDirectory() as tmp:
+        _tank_model(Path(tmp) / "ok", lambda tank, actor: (tank, actor))
+        assert load_tank_policy(Path(tmp) / "ok").step_turns == 5
 
 
 # (arguments with {ws} for the workspace, text the error line must contain, path that must not appear)
@@ -126,6 +181,19 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
     ("demo of 0 rounds", ["demo", "--rounds", "0"], "--rounds", None),
     ("config show with a bad override", ["config", "show", "demo", "--set", "learner.hidden=[-3]"],
      "learner.hidden[0]", None),
+    # issue 34 items 6, 7, 21: hand-edited models are refused before they play or export
+    ("evaluate an all-NaN DMNN", ["evaluate", "{ws}/nanmodel", "--rounds", "2"], "NaN", None),
+    ("export an all-NaN DMNN", ["export", "{ws}/nanmodel", "--out", "{ws}/nan.jar"], "NaN", "nan.jar"),
+    ("evaluate a DMNN claiming 10^5 x 10^5 weights", ["evaluate", "{ws}/hugemodel", "--rounds", "2"],
+     "do not fit", None),
+    ("export a tank held 1e30 turns", ["export", "{ws}/tank-step", "--out", "{ws}/t.jar"], "step_turns", "t.jar"),
+    ("export a tank.json that is no JSON", ["export", "{ws}/tank-json", "--out", "{ws}/t.jar"], "tank-json",
+     "t.jar"),
+    ("export an all-NaN actor", ["export", "{ws}/tank-nan", "--out", "{ws}/t.jar"], "non-finite", "t.jar"),
+    ("export an actor of the wrong size", ["export", "{ws}/tank-wrong", "--out", "{ws}/t.jar"], "do not chain",
+     "t.jar"),
+    ("export a truncated actor.npz", ["export", "{ws}/tank-truncated", "--out", "{ws}/t.jar"], "tank-truncated",
+     "t.jar"),
     # issue 34 item 11: scenarios too big for memory, and team sizes that are not whole numbers
     ("scenario of 6000 robots", ["train", "--set", "arena.scenario={ws}/crowd.toml", "--out", "{ws}/new"],
      "at most 256", "new"),

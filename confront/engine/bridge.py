@@ -781,10 +781,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     token = os.environ.get(TOKEN_ENV, "")
     if len(args) not in (1, 2) or not token:
-        print(main.__doc__)
+        print(main.__doc__, file=sys.stderr)
         return 2
-    policy = load_policy(args[1]) if len(args) == 2 else nearest_enemy_policy
-    server = BridgeServer(policy, token=token, port=int(args[0]))
+
+    def refuse(text: str) -> int:
+        print(f"error: {' '.join(text.split())[:300]}", file=sys.stderr)
+        return 2
+
+    if not args[0].isascii() or not args[0].isdigit() or not 0 <= int(args[0]) <= 65535:
+        return refuse(f"PORT must be a number from 0 to 65535 (0: any free port), got {args[0][:40]!r}")
+    try:
+        policy = load_policy(args[1]) if len(args) == 2 else nearest_enemy_policy
+    except (ImportError, AttributeError, ValueError) as exc:
+        return refuse(f"policy {args[1][:100]!r} cannot be loaded (give module:function): {exc}")
+    if not callable(policy):
+        return refuse(f"policy {args[1][:100]!r} is not a function")
+    try:
+        server = BridgeServer(policy, token=token, port=int(args[0]))
+    except OSError as exc:
+        return refuse(f"cannot listen on port {args[0]}: {exc.strerror or exc}")
     server.on_hello = lambda h: print(f"hello {h['name']} round {h['round']}", flush=True)
     print(f"ready {server.port}", flush=True)
     try:

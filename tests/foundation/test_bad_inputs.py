@@ -353,3 +353,20 @@ def test_full_disk_at_a_checkpoint_is_one_line_and_keeps_the_run(ws: Path, tmp_p
     assert result.exit_code == 2 and result.stderr == "error: No space left on device\n", result.output
     assert (tmp_path / "run" / "config.toml").is_file()
     assert [p.name for p in (tmp_path / "run" / "checkpoints").iterdir()] == []
+
+
+@pytest.mark.parametrize(("args", "expect"), [(["99999"], "PORT must be"), (["abc"], "PORT must be"),
+                                              (["0", "nosuchmodule:f"], "cannot be loaded"),
+                                              (["0", "json"], "module:function"), (["0", "json:nothing"], "nothing"),
+                                              (["0", "json:__doc__"], "not a function")])
+def test_bridge_command_refuses_a_bad_port_or_policy_in_one_line(args: list[str], expect: str,
+                                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 34 item 18: docs/engine.md's bridge command (the token from the environment), bad arguments."""
+    monkeypatch.setenv("CONFRONT_BRIDGE_TOKEN", "t" * 32)
+    proc = subprocess.run([sys.executable, "-m", "confront.engine.bridge", *args], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and expect in proc.stderr, proc.stderr
+    docs = (Path(__file__).parents[2] / "docs" / "engine.md").read_text()
+    assert "bridge PORT TOKEN" not in docs and "CONFRONT_BRIDGE_TOKEN=<token> python -m confront.engine.bridge PORT" \
+        in docs

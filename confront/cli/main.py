@@ -94,7 +94,8 @@ def cli() -> None:
 
 
 @cli.command()
-@click.option("--out", type=click.Path(path_type=Path), default=None, help="Run folder (default runs/demo-<time>).")
+@click.option("--out", type=click.Path(path_type=Path), default=None,
+              help="Run folder (default runs/tanks-demo-<time>; with --paper runs/demo-<time>).")
 @click.option("--rounds", type=COUNT, default=None, help="Rounds to train (default from the demo config).")
 @click.option("--seed", type=SEED, default=None)
 @click.option("--paper", is_flag=True, help="Train the paper's 4v4 fuzzy DMNN arm instead (config demo).")
@@ -152,7 +153,10 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
 @cli.command()
 @click.argument("run", type=click.Path(path_type=Path, exists=True, file_okay=False))
 @click.option("--engine", type=click.Choice(["sim", "robocode"]), default="sim", show_default=True)
-@click.option("--opponents", default=None, help="Comma list of opponents (default: the run's).")
+@click.option("--opponents", default=None, metavar="LIST",
+              help="Comma list of opponents (default: the run's). PPO tank runs: league entries SCENARIO:NAME, "
+                   "e.g. 1v1:SpinBot,4v4:td (a bare NAME is 1v1:NAME); paper runs: td or a scripted robot "
+                   "(SpinBot, Walls, Tracker, RamFire, ...) or a sample team (MyFirstTeam).")
 @click.option("--rounds", type=ROUNDS, default=100, show_default=True)
 @click.option("--seed", type=SEED, default=0, show_default=True)
 @click.option("--play", type=click.Choice(["sampled", "greedy"]), default=None,
@@ -267,6 +271,9 @@ def export(run: Path, out: Path, play: str | None) -> None:
     from confront.engine.tank_export import Play, export_tank_cli, is_tank_run
     from confront.experiments.evaluate import export_cli
 
+    if out.suffix not in ("", ".jar") and not out.is_dir():  # x.zip would silently become a folder named x.zip
+        raise click.UsageError(f"--out {out} must be a robots folder (a name without a suffix, or an existing folder) "
+                               "or a .jar")
     if is_tank_run(run):  # a PPO run over the tank view: confront.TankBot
         export_tank_cli(run, out=out, play=cast(Play, play or "sampled"))  # click checked it is one of the two
         return
@@ -309,7 +316,8 @@ def rumble(candidate: str, folder: Path, mode: str, seeds: int, rounds: int | No
 
 @cli.command()
 @click.argument("source", type=click.Path(path_type=Path, exists=True))
-@click.option("--out", type=click.Path(path_type=Path), default=None, help="Output stem (default beside the source).")
+@click.option("--out", type=click.Path(path_type=Path, file_okay=False), default=None,
+              help="Folder to write the GIF and HTML player into (default: beside each replay file).")
 def replay(source: Path, out: Path | None) -> None:
     """Write a GIF and a self-contained HTML player for a replay file or a run's replays."""
     from confront.experiments.evaluate import replay_cli

@@ -194,6 +194,9 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
      "t.jar"),
     ("export a truncated actor.npz", ["export", "{ws}/tank-truncated", "--out", "{ws}/t.jar"], "tank-truncated",
      "t.jar"),
+    # issue 34 frictions: export --out x.zip made a folder named x.zip
+    ("export to a .zip", ["export", "{ws}/run", "--out", "{ws}/x.zip"], "must be a robots folder", "x.zip"),
+    ("replay --out onto a file", ["replay", "{ws}/nokeys.replay.json", "--out", "{ws}/afile"], "--out", None),
     # issue 34 item 11: scenarios too big for memory, and team sizes that are not whole numbers
     ("scenario of 6000 robots", ["train", "--set", "arena.scenario={ws}/crowd.toml", "--out", "{ws}/new"],
      "at most 256", "new"),

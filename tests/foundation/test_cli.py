@@ -48,3 +48,17 @@ def test_unknown_experiment_and_bad_toml(tmp_path) -> None:
     result = CliRunner().invoke(cli, ["config", "show", str(bad)])
     assert result.exit_code == 2
     assert "is not valid TOML" in result.output
+
+
+def test_help_texts_say_what_a_newcomer_needs() -> None:
+    """Issue 34 frictions: --opponents' format and names, the demo's real default folder, replay --out a folder."""
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+
+    def help_of(*cmd: str) -> str:
+        return " ".join(CliRunner().invoke(cli, [*cmd, "--help"]).output.split())
+
+    assert "SCENARIO:NAME, e.g. 1v1:SpinBot,4v4:td" in help_of("evaluate")
+    assert "runs/tanks-demo-<time>" in help_of("demo")
+    assert "Folder to write the GIF and HTML player into" in help_of("replay")

@@ -62,3 +62,16 @@ def test_help_texts_say_what_a_newcomer_needs() -> None:
     assert "SCENARIO:NAME, e.g. 1v1:SpinBot,4v4:td" in help_of("evaluate")
     assert "runs/tanks-demo-<time>" in help_of("demo")
     assert "Folder to write the GIF and HTML player into" in help_of("replay")
+
+
+def test_readme_uses_the_demos_run_and_test_script_reports_parts() -> None:
+    """Issue 34 frictions: the README's Robocode block trained a second demo; scripts/test.sh printed only dots."""
+    from pathlib import Path
+
+    root = Path(__file__).parents[2]
+    readme = root / "README.md"
+    block = readme.read_text().split("Your trained tanks in Robocode itself", 1)[1].split("```", 2)[1]
+    assert "demo" not in block.replace("runs/tanks-demo-*", "").replace("the demo above", "")
+    assert "runs/tanks-demo-*" in block
+    script = (root / "scripts" / "test.sh").read_text()
+    assert "== pip install" in script and "== summary" in script and "for part in tests/" in script

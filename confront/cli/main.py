@@ -331,12 +331,16 @@ def replay(source: Path, out: Path | None) -> None:
 @click.option("--plot", type=click.Path(path_type=Path), is_flag=False, flag_value=Path("sim_scaling.png"),
               default=None, help="sim only: write the scaling figure (throughput against batch size and threads) "
                                  "to this PNG (default sim_scaling.png) instead of the table.")
-def bench(what: str, plot: Path | None) -> None:
+@click.option("--json", "as_json", is_flag=True,
+              help="sim and env: also print the records as one JSON list on the last line.")
+def bench(what: str, plot: Path | None, as_json: bool) -> None:
     """Run a benchmark script from benchmarks/ and print its table."""
-    from confront.experiments.evaluate import bench_cli
+    from confront.experiments.evaluate import JSON_BENCHES, bench_cli
 
+    if as_json and what not in JSON_BENCHES:
+        raise click.UsageError(f"--json is for {' and '.join(JSON_BENCHES)}")
     if plot is None:
-        bench_cli(what)
+        bench_cli(what, as_json=as_json)
         return
     if what != "sim":
         raise click.UsageError("--plot is for `confront bench sim`")
@@ -345,7 +349,7 @@ def bench(what: str, plot: Path | None) -> None:
     script = Path(__file__).resolve().parents[2] / "benchmarks" / "sim_throughput.py"
     if not script.is_file():
         raise FileNotFoundError("benchmarks/ is not here: run `confront bench` from a source checkout")
-    subprocess.run([sys.executable, str(script), "--plot", str(plot)], check=False)
+    subprocess.run([sys.executable, str(script), "--plot", str(plot), *(["--json"] if as_json else [])], check=False)
 
 
 @cli.group(cls=Group)

@@ -322,11 +322,15 @@ BENCHES = {"sim": "sim_throughput.py", "learner": "learner_throughput.py", "env"
            "bridge": "bridge_throughput.py", "reproduce": "reproduce_time.py", "train": "train_throughput.py"}
 
 
-def bench_cli(what: str) -> None:
+JSON_BENCHES = ("sim", "env")  # scripts whose --json prints their records as the last line
+
+
+def bench_cli(what: str, as_json: bool = False) -> None:
     root = Path(__file__).resolve().parents[2] / "benchmarks"
     if not root.is_dir():
         raise FileNotFoundError("benchmarks/ is not here: run `confront bench` from a source checkout")
     for key in (BENCHES if what == "all" else [what]):
         script = root / BENCHES[key]
         click.echo(f"== {script.name}")
-        subprocess.run([sys.executable, str(script)], check=False)
+        subprocess.run([sys.executable, str(script), *(["--json"] if as_json and key in JSON_BENCHES else [])],
+                       check=False)

@@ -75,3 +75,17 @@ def test_readme_uses_the_demos_run_and_test_script_reports_parts() -> None:
     assert "runs/tanks-demo-*" in block
     script = (root / "scripts" / "test.sh").read_text()
     assert "== pip install" in script and "== summary" in script and "for part in tests/" in script
+
+
+def test_bench_json_passes_through(monkeypatch) -> None:  # noqa: ANN001 - pytest's MonkeyPatch
+    """Issue 34 friction: `confront bench sim` printed no JSON last line; --json asks the script for it."""
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+
+    calls: list[list[str]] = []
+    monkeypatch.setattr("subprocess.run", lambda cmd, check: calls.append(list(cmd)))
+    assert CliRunner().invoke(cli, ["bench", "sim", "--json"]).exit_code == 0
+    assert calls[-1][-2].endswith("sim_throughput.py") and calls[-1][-1] == "--json"
+    res = CliRunner().invoke(cli, ["bench", "learner", "--json"])
+    assert res.exit_code == 2 and "--json is for sim and env" in res.output

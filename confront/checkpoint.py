@@ -57,10 +57,21 @@ def rng_state(rng: np.random.Generator) -> dict[str, Any]:
     return dict(rng.bit_generator.state)
 
 
+BIT_GENERATORS = ("PCG64", "PCG64DXSM", "MT19937", "Philox", "SFC64")  # numpy's; no other name is looked up
+
+
 def rng_from_state(state: Mapping[str, Any]) -> np.random.Generator:
-    """Rebuild a Generator from :func:`rng_state` output."""
-    bit_gen = getattr(np.random, state["bit_generator"])()
-    bit_gen.state = dict(state)
+    """Rebuild a Generator from :func:`rng_state` output; CheckpointError if it is not one (an edited name such
+    as ``seed`` would otherwise call ``np.random.seed`` and reseed NumPy's global generator)."""
+    name = state.get("bit_generator") if isinstance(state, Mapping) else None
+    if name not in BIT_GENERATORS:
+        raise CheckpointError(f"a generator state names the bit generator {str(name)[:40]!r}: expected one of "
+                              f"{', '.join(BIT_GENERATORS)}")
+    try:
+        bit_gen = getattr(np.random, name)()
+        bit_gen.state = dict(state)
+    except (ValueError, TypeError, KeyError, OverflowError) as exc:
+        raise CheckpointError(f"a {name} generator state does not fit: {' '.join(str(exc).split())[:200]}") from None
     return np.random.Generator(bit_gen)
 
 

@@ -199,3 +199,17 @@ def test_save_refuses_a_symlinked_checkpoints_folder_and_a_foreign_name(tmp_path
     with pytest.raises(ck.CheckpointError, match="not a checkpoint confront wrote"):
         _save(mine, "round-000003", 2.0)
     assert (mine / "round-000003" / "keep.txt").read_text() == "k"
+
+
+def test_an_edited_generator_state_is_refused_and_reseeds_nothing() -> None:
+    """Issue 34 item 13: a checkpoint's rng naming 'seed' called np.random.seed (NumPy's global generator)."""
+    np.random.seed(5)
+    expected = np.random.random()
+    np.random.seed(5)
+    good = ck.rng_state(np.random.default_rng(1))
+    for bad in ({**good, "bit_generator": "seed"}, {**good, "bit_generator": "RandomState"},
+                {**good, "state": {"state": "x", "inc": 1}}, {"bit_generator": "PCG64"}):
+        with pytest.raises(ck.CheckpointError, match="generator"):
+            ck.rng_from_state(bad)
+    assert np.random.random() == expected
+    assert ck.rng_from_state(good).random() == np.random.default_rng(1).random()

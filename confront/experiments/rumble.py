@@ -18,6 +18,7 @@ import json
 import math
 import os
 import re
+import textwrap
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -253,7 +254,7 @@ def plot_rows(rows: Sequence[RumbleRow], title: str, path: Path) -> None:
     ax.axvline(0.5, color="k", lw=0.6, ls=":")
     ax.set_xlim(0, 1)
     ax.set_xlabel("APS: the candidate's share of the score (95% t-interval over seeds)")
-    ax.set_title(title, fontsize=10)
+    ax.set_title("\n".join(textwrap.wrap(title, 80)), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

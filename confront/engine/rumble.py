@@ -111,11 +111,6 @@ def folder_robots(folder: str | os.PathLike[str]) -> list[Robot]:
     return [r for jar in sorted(folder.glob("*.jar")) for r in jar_robots(jar)]
 
 
-def plain(name: str) -> str:
-    """A robot's name without its version: 'pkg.Bot 1.0' -> 'pkg.Bot'."""
-    return name.split(" ")[0]
-
-
 # -- one battle ---------------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class BattleJob:
@@ -166,9 +161,15 @@ def robot_problems(summary: dict[str, Any], names: Iterable[str]) -> dict[str, s
     lines = [" ".join(str(s).strip(". \n").split()) for s in
              [*summary.get("errors", []), *summary.get("messages", []), *summary.get("robot_reports", [])]]
     out: dict[str, str] = {}
+    names = list(names)
     for name in names:
-        mine = [ln for ln in lines if name in ln or f"'{plain(name)}" in ln]
-        skipped = sum(n for robot, n in summary.get("skipped_turns", {}).items() if robot.startswith(name))
+        longer = [o for o in names if o != name and o.startswith(name)]  # sample.Tracker vs sample.Tracker 1.0
+
+        def about(text: str, name: str = name, longer: list[str] = longer) -> bool:
+            return name in text and not any(o in text for o in longer)
+
+        mine = [ln for ln in lines if about(ln)]
+        skipped = sum(n for robot, n in summary.get("skipped_turns", {}).items() if about(robot))
         found = (
             next((f"not loaded: {ln}" for ln in mine if "Can't find" in ln), None)
             or next((f"throws: {ln}" for ln in mine if "Exception" in ln or "Error:" in ln), None)

@@ -95,6 +95,11 @@ def test_engine_words_are_read_per_robot() -> None:
         "x.T 1.0": "throws: x.T 1.0: Exception: java.lang.IllegalStateException: boom",
         "x.S 1.0": "overran its time: 3 skipped turn(s) (x.S 1.0: skipped round=0 turn 31)",
     }
+    # a robot whose name begins another's (the candidate sample.Tracker, the jar's sample.Tracker 1.0)
+    other = {"errors": ["Robot sample.Tracker 1.0 (2) is not stopping."], "skipped_turns": {"sample.Tracker (1)": 2}}
+    assert robot_problems(other, ["sample.Tracker", "sample.Tracker 1.0"]) == {
+        "sample.Tracker": "overran its time: 2 skipped turn(s)",
+        "sample.Tracker 1.0": "hangs: Robot sample.Tracker 1.0 (2) is not stopping"}
 
 
 def test_jars_and_teams_are_read_from_properties(tmp_path: Path) -> None:

@@ -265,6 +265,16 @@ class RunStats:
     played: int = 0
     elapsed_s: float = 0.0
     keys_played: list[str] = field(default_factory=list)
+    unplayed: list[dict[str, Any]] = field(default_factory=list)  # battles Python could not run: not stored
+
+
+def _not_played(job: BattleJob, err: BaseException) -> dict[str, Any]:
+    """The result of a battle that could not be run at all (no engine, a worker lost, ...): a row that says so,
+    not stored, so the next run tries it again."""
+    return {"key": job.key, "mode": job.mode, "seed": job.seed, "rounds": job.rounds, "candidate": job.candidate.name,
+            "opponents": [o.name for o in job.opponents], "status": "failed", "problems": {}, "contestants": [],
+            "stored": False, "reason": f"failed: the battle could not be run ({type(err).__name__}: "
+                                       f"{' '.join(str(err).split())[:300]}); the next run tries it again"}
 
 
 def run_jobs(jobs: Sequence[BattleJob], jar_files: dict[str, Path], battles_dir: Path, workers: int = 1,
@@ -286,9 +296,12 @@ def run_jobs(jobs: Sequence[BattleJob], jar_files: dict[str, Path], battles_dir:
 
     with tqdm(total=len(todo), desc="rumble", unit="battle", disable=not progress) as bar:
         def done(result: dict[str, Any]) -> None:
-            write_json_atomic(battles_dir / f"{result['key']}.json", result)
-            stats.played += 1
-            stats.keys_played.append(result["key"])
+            if result.get("stored", True):
+                write_json_atomic(battles_dir / f"{result['key']}.json", result)
+                stats.played += 1
+                stats.keys_played.append(result["key"])
+            else:
+                stats.unplayed.append(result)
             bar.set_postfix_str(f"{result['key']}: {result['status']}")
             bar.update(1)
 
@@ -306,17 +319,25 @@ def _run_local(todo: Sequence[BattleJob], jar_paths: Callable[[BattleJob], dict[
     here."""
     if workers <= 1:
         for job in todo:
-            done(_play_from_files(job, jar_paths(job)))
+            try:
+                done(_play_from_files(job, jar_paths(job)))
+            except Exception as err:  # noqa: BLE001 - the rest of the rumble goes on; the row says what failed
+                done(_not_played(job, err))
         return
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
     with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        pending = {pool.submit(_play_from_files, job, jar_paths(job)) for job in todo}
+        jobs = {pool.submit(_play_from_files, job, jar_paths(job)): job for job in todo}
+        pending = set(jobs)
         while pending:
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:
-                done(fut.result())
+                try:
+                    result = fut.result()
+                except Exception as err:  # noqa: BLE001 - a worker lost or a battle that could not start
+                    result = _not_played(jobs[fut], err)
+                done(result)
 
 
 def _run_ray(todo: Sequence[BattleJob], jar_paths: Callable[[BattleJob], dict[str, str]], address: str,
@@ -339,8 +360,12 @@ def _run_ray(todo: Sequence[BattleJob], jar_paths: Callable[[BattleJob], dict[st
         pending[remote.remote(job, list(paths), *(refs[n] for n in paths))] = job
     while pending:
         ready, _ = ray.wait(list(pending), num_returns=1)
-        pending.pop(ready[0])
-        done(ray.get(ready[0]))
+        job = pending.pop(ready[0])
+        try:
+            result = ray.get(ready[0])
+        except Exception as err:  # noqa: BLE001 - a task lost (a node gone, no engine there)
+            result = _not_played(job, err)
+        done(result)
 
 
 def sample_jars(folder: str | os.PathLike[str], names: Sequence[str], version: str = "1.0",

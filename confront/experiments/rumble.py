@@ -304,7 +304,8 @@ def run_rumble(candidate: str, folder: str | os.PathLike[str], settings: RumbleS
         if robot.jar != jar.name:
             raise ValueError(f"candidate jar {jar.name} is not where its robot was read")
     stats = run_jobs(jobs, jar_files, out / "battles", workers=workers, address=address, progress=progress)
-    results = [json.loads((out / "battles" / f"{j.key}.json").read_text()) for j in jobs]
+    results = [json.loads(f.read_text()) for j in jobs if (f := out / "battles" / f"{j.key}.json").is_file()]
+    results += stats.unplayed
     rows = table_rows(opponents, results, robot.name)
     s = settings
     title = (f"{robot.name} ({s.mode}{f', teams of {s.team_size}' if s.mode == 'teams' else ''}), {s.rounds} rounds "
@@ -339,4 +340,6 @@ def rumble_cli(candidate: str, folder: Path, mode: str, seeds: int, rounds: int 
         raise click.UsageError(str(err)) from None
     click.echo(report.markdown)
     st = report.stats
-    click.echo(f"{st.played} battle(s) played, {st.done_before} already done; table, CSV, JSON and plot in {out}")
+    click.echo(f"{st.played} battle(s) played, {st.done_before} already done"
+               + (f", {len(st.unplayed)} could not be run (tried again next time)" if st.unplayed else "")
+               + f"; table, CSV, JSON and plot in {out}")

@@ -178,3 +178,19 @@ def test_changed_settings_refused(tmp_path: Path) -> None:
     res = CliRunner().invoke(cli, ["rumble", str(_jar(tmp_path / "me.jar", "p.Me")), str(tmp_path / "f"), "--out",
                                    str(out)])
     assert res.exit_code == 2 and "holds a rumble with other settings" in res.output
+
+
+def test_a_battle_that_cannot_run_is_a_row_and_not_stored(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import confront.engine.rumble as rumble
+
+    def broken(job: object, jars: object) -> dict[str, Any]:
+        raise RuntimeError("javac failed:\nsomething")
+
+    monkeypatch.setattr(rumble, "_play_from_files", broken)
+    jobs = plan_jobs(Robot("sample.Tracker"), [Robot("o.A 1.0", "a.jar")], RumbleSettings(seeds=2))
+    stats = rumble.run_jobs(jobs, {"a.jar": tmp_path / "a.jar"}, tmp_path / "battles", progress=False)
+    assert stats.played == 0 and len(stats.unplayed) == 2 and not (tmp_path / "battles").exists()
+    row = table_rows([Robot("o.A 1.0", "a.jar")], stats.unplayed, "sample.Tracker")[0]
+    assert row.status == "failed" and row.battles == 0
+    assert row.reason == ("failed: the battle could not be run (RuntimeError: javac failed: something); the next run "
+                          "tries it again")

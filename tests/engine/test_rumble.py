@@ -1,7 +1,7 @@
-"""``confront rumble`` in the real engine: a folder of sample robots, a corrupt jar, a robot that throws in run()
-and one that never returns from its turn gives a complete table with the three bad ones and their reasons (exit 0);
-the same command again plays no battle; a trained run is exported on the way; a local Ray cluster gives the same
-table."""
+"""``confront rumble`` in the real engine: a folder of sample robots, a corrupt jar, a robot that throws in run(),
+one that never returns from its turn and one that overruns its time give a complete table with the bad ones and
+their reasons (exit 0); the same command again plays no battle; a trained run is exported on the way; a local Ray
+cluster gives the same table."""
 
 from __future__ import annotations
 
@@ -26,8 +26,8 @@ SAMPLES = ("SpinBot", "Crazy")
 
 
 def bad_robot_jars(install: EngineInstall, folder: Path) -> None:
-    """The fixtures' robots (rumblebad.Thrower, rumblebad.Hanger) compiled into a jar each, and a jar of random
-    bytes."""
+    """The fixtures' robots (rumblebad.Thrower, rumblebad.Hanger, rumblebad.Slow) compiled into a jar each, and a
+    jar of random bytes."""
     build = folder.parent / "build"
     sources = sorted((FIXTURES / "rumblebad").glob("*.java"))
     subprocess.run([install.javac, "-nowarn", "-encoding", "UTF-8", "-cp", install.classpath, "-d", str(build),
@@ -57,10 +57,10 @@ def test_rumble_bad_robots_and_resume(folder: Path, tmp_path: Path) -> None:
     args = ["rumble", "sample.Tracker", str(folder), "--rounds", "2", "--workers", "2", "--out", str(out), "--quiet"]
     res = CliRunner().invoke(cli, args)
     assert res.exit_code == 0, res.output
-    assert "4 battle(s) played, 0 already done" in res.output
+    assert "5 battle(s) played, 0 already done" in res.output
     rows = _rows(out)
-    assert sorted(rows) == ["corrupt", "rumblebad.Hanger 1.0", "rumblebad.Thrower 1.0", "sample.Crazy 1.0",
-                            "sample.SpinBot 1.0"]
+    assert sorted(rows) == ["corrupt", "rumblebad.Hanger 1.0", "rumblebad.Slow 1.0", "rumblebad.Thrower 1.0",
+                            "sample.Crazy 1.0", "sample.SpinBot 1.0"]
     assert rows["corrupt"]["status"] == "not loaded" and rows["corrupt"]["battles"] == 0
     assert "corrupt.jar is not a readable jar (File is not a zip file)" in rows["corrupt"]["reason"]
     thrower = rows["rumblebad.Thrower 1.0"]
@@ -69,6 +69,9 @@ def test_rumble_bad_robots_and_resume(folder: Path, tmp_path: Path) -> None:
     assert thrower["aps"] == 1.0  # it never scores
     hanger = rows["rumblebad.Hanger 1.0"]
     assert hanger["status"] == "hangs" and "rumblebad.Hanger 1.0 is not stopping" in hanger["reason"]
+    slow = rows["rumblebad.Slow 1.0"]  # 60 ms every tenth turn at a 10 ms CPU constant
+    assert slow["status"] == "overran its time" and slow["battles"] == 1
+    assert "skipped turn(s) (rumblebad.Slow 1.0: skipped round=0 skipped turn " in slow["reason"]
     for name in ("sample.Crazy 1.0", "sample.SpinBot 1.0"):
         row = rows[name]
         assert row["status"] == "ok" and row["battles"] == 1 and row["reason"] == ""
@@ -82,10 +85,10 @@ def test_rumble_bad_robots_and_resume(folder: Path, tmp_path: Path) -> None:
         assert (out / f).stat().st_size > 0
     assert "| rumblebad.Thrower 1.0 | 1.000 |" in res.output  # the Markdown table is printed
     stamps = {p.name: p.stat().st_mtime_ns for p in (out / "battles").glob("*.json")}
-    assert len(stamps) == 4
+    assert len(stamps) == 5
     again = CliRunner().invoke(cli, args)
     assert again.exit_code == 0, again.output
-    assert "0 battle(s) played, 4 already done" in again.output
+    assert "0 battle(s) played, 5 already done" in again.output
     assert {p.name: p.stat().st_mtime_ns for p in (out / "battles").glob("*.json")} == stamps
     assert _rows(out) == rows
 

@@ -128,3 +128,25 @@ def test_local_ray_cluster_gives_the_same_table(folder: Path, tmp_path: Path) ->
     assert on_ray.markdown == local.markdown  # the same table, number for number
     assert (tmp_path / "ray" / "rumble.csv").read_text() == (tmp_path / "local" / "rumble.csv").read_text()
     assert all(r.status == "ok" and r.battles == 1 for r in on_ray.rows)
+
+
+@pytest.mark.parametrize("mode", ["teams", "melee"])
+def test_teams_and_melee(folder: Path, tmp_path: Path, mode: str) -> None:
+    two = tmp_path / "two"
+    two.mkdir()
+    for name in SAMPLES:
+        (two / f"sample.{name}_1.0.jar").write_bytes((folder / f"sample.{name}_1.0.jar").read_bytes())
+    out = tmp_path / "out"
+    res = CliRunner().invoke(cli, ["rumble", "sample.Tracker", str(two), "--mode", mode, "--team-size", "2",
+                                   "--rounds", "2", "--field", "800x800", "--out", str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    battles = [json.loads(p.read_text()) for p in sorted((out / "battles").glob("*.json"))]
+    assert len(battles) == (2 if mode == "teams" else 1)  # a battle per opponent, or one melee of all three
+    rows = _rows(out)
+    for b in battles:
+        ours = b["contestants"][0]
+        assert ours["name"] == ("confrontteams.Ours (1)" if mode == "teams" else "sample.Tracker")
+        for opp, theirs in zip(b["opponents"], b["contestants"][1:], strict=True):
+            assert mode == "teams" or theirs["name"] == opp
+            assert rows[opp]["aps"] == pytest.approx(ours["total"] / (ours["total"] + theirs["total"]))
+            assert rows[opp]["survival_pct"] == pytest.approx(100 * ours["firsts"] / 2)

@@ -44,6 +44,14 @@ SUBDIRS = ("metrics", "plots", "checkpoints", "replays")
 LOCK = ".lock"
 
 
+class Interrupted(Exception):
+    """Training stopped on request (Ctrl-C) after saving a checkpoint of the step it had finished."""
+
+    def __init__(self, run: Path, rounds_done: int, checkpoint: Path) -> None:
+        super().__init__(f"stopped after {rounds_done} rounds; saved {checkpoint}")
+        self.run, self.rounds_done, self.checkpoint = run, rounds_done, checkpoint
+
+
 class RunBusyError(FileExistsError):
     """Another run (a live process) holds the run folder's lock."""
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shlex
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -12,7 +13,9 @@ from typing import Any, cast
 import click
 
 from confront.checkpoint import CheckpointError
+from confront.cli import command
 from confront.config import ConfigError
+from confront.runs import Interrupted
 
 USER_ERRORS: tuple[type[BaseException], ...] = (ConfigError, CheckpointError, FileExistsError, FileNotFoundError,
                                                NotADirectoryError, IsADirectoryError)
@@ -53,6 +56,9 @@ class Group(click.Group):
             where = f" (see `{exc.ctx.command_path} --help`)" if exc.ctx is not None else ""
             click.echo(f"error: {_one_line(exc.format_message())}{where}", err=True)
             sys.exit(2)
+        except Interrupted as stop:  # Ctrl-C during training: the checkpoint saved and how to go on
+            click.echo(f"{stop}\ncontinue with: {command()} train --resume {shlex.quote(str(stop.run))}", err=True)
+            sys.exit(130)
         except USER_ERRORS + _engine_errors() as exc:
             click.echo(f"error: {_one_line(str(exc))}", err=True)
             sys.exit(2)

@@ -89,3 +89,21 @@ def test_bench_json_passes_through(monkeypatch) -> None:  # noqa: ANN001 - pytes
     assert calls[-1][-2].endswith("sim_throughput.py") and calls[-1][-1] == "--json"
     res = CliRunner().invoke(cli, ["bench", "learner", "--json"])
     assert res.exit_code == 2 and "--json is for sim and env" in res.output
+
+
+def test_a_stopped_training_says_how_to_continue(monkeypatch, tmp_path) -> None:  # noqa: ANN001 - pytest's fixtures
+    """Issue 34 friction: Ctrl-C printed only "Aborted!"; now the saved checkpoint and the resume command."""
+    from click.testing import CliRunner
+
+    import confront.cli.main as main
+    from confront.runs import Interrupted
+
+    def stopped(*args: object, **kwargs: object) -> None:
+        raise Interrupted(tmp_path / "my run", 40, tmp_path / "my run" / "checkpoints" / "round-000040")
+
+    monkeypatch.setattr("confront.experiments.demo.run_demo", stopped)
+    res = CliRunner().invoke(main.cli, ["demo", "--rounds", "8"])
+    assert res.exit_code == 130, res.output
+    lines = res.stderr.strip().splitlines()
+    assert lines[0] == f"stopped after 40 rounds; saved {tmp_path}/my run/checkpoints/round-000040"
+    assert lines[1].startswith("continue with: ") and lines[1].endswith(f"train --resume '{tmp_path}/my run'")

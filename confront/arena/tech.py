@@ -44,11 +44,11 @@ MV_ORBIT, MV_STOPGO, MV_RAM, MV_SURF, MV_RISK = range(5)
 # name: (gun, movement), as the Java subclasses pick them (confront.engine.tech_robots lists the same names)
 TECH_ROBOTS: dict[str, tuple[int, int]] = {
     "RamHeadOn": (G_HEAD, MV_RAM),
-    "OrbitLinear": (G_LINEAR, MV_ORBIT),
     "StopGoCircular": (G_CIRCULAR, MV_STOPGO),
+    "OrbitLinear": (G_LINEAR, MV_ORBIT),
     "OrbitCircular": (G_CIRCULAR, MV_ORBIT),
-    "OrbitGF": (G_GF, MV_ORBIT),
     "OrbitVG": (G_VIRTUAL, MV_ORBIT),
+    "OrbitGF": (G_GF, MV_ORBIT),
     "SurfCircular": (G_CIRCULAR, MV_SURF),
     "SurfGF": (G_GF, MV_SURF),
     "SurfVG": (G_VIRTUAL, MV_SURF),

@@ -21,14 +21,14 @@ from confront.engine.java_build import JAVA_SOURCES, compile_java
 
 VERSION = "1.0"
 JAR_NAME = "confront-tech.jar"
-# name: (gun, movement), in rising strength (measured in docs/results/tech; the last is for melee and teams)
+# name: (gun, movement), in rising strength in 1v1 (docs/results/tech/README.md); RiskGF is for melee and teams
 TECH_ROBOTS: dict[str, tuple[str, str]] = {
     "RamHeadOn": ("head-on", "ramming"),
-    "OrbitLinear": ("linear", "random orbit, wall smoothing"),
     "StopGoCircular": ("circular", "stop-and-go"),
+    "OrbitLinear": ("linear", "random orbit, wall smoothing"),
     "OrbitCircular": ("circular", "random orbit, wall smoothing"),
-    "OrbitGF": ("GuessFactor", "random orbit, wall smoothing"),
     "OrbitVG": ("virtual guns", "random orbit, wall smoothing"),
+    "OrbitGF": ("GuessFactor", "random orbit, wall smoothing"),
     "SurfCircular": ("circular", "wave surfing"),
     "SurfGF": ("GuessFactor", "wave surfing"),
     "SurfVG": ("virtual guns", "wave surfing"),

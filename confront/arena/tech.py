@@ -588,17 +588,25 @@ def _decide(b, i, gun_kind, move_kind, m, st, rng, mates, rf, rb, ri, bi, kf, ki
     m[T_PREVV] = rf[b, K.V, i]
 
 
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def tech_battle_step(b, guns, moves, mem, stat, rng, mates, rf, rb, ri, bi, kf, ki, scanned, scan_order, cmd, w, h,
+                     hit_p, hit_h):
+    """One decision of every alive technique robot of battle b (a compiled turn loop calls it per battle). A robot
+    that died decides nothing more: the Java robot's onDeath stops its decisions (its last wake handles the turn's
+    events only)."""
+    for i in range(rf.shape[2]):
+        if guns[i] >= 0 and rb[b, K.ALIVE, i]:
+            _decide(b, i, guns[i], moves[i], mem[b, i], stat[b, i], rng, mates[i], rf, rb, ri, bi, kf, ki, scanned,
+                    scan_order, cmd[b, i], w, h, hit_p, hit_h)
+
+
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
 def tech_step(guns, moves, mem, stat, rng, mates, rf, rb, ri, bi, kf, ki, scanned, scan_order, cmd, w, h, hit_p,
               hit_h):
-    """One decision of every alive technique robot in every battle (cmd rows: NaN = keep). A robot that died
-    decides nothing more: the Java robot's onDeath stops its decisions (its last wake handles the turn's events
-    only)."""
+    """One decision of every alive technique robot in every battle (cmd rows: NaN = keep)."""
     for b in range(rf.shape[0]):
-        for i in range(rf.shape[2]):
-            if guns[i] >= 0 and rb[b, K.ALIVE, i]:
-                _decide(b, i, guns[i], moves[i], mem[b, i], stat[b, i], rng, mates[i], rf, rb, ri, bi, kf, ki,
-                        scanned, scan_order, cmd[b, i], w, h, hit_p, hit_h)
+        tech_battle_step(b, guns, moves, mem, stat, rng, mates, rf, rb, ri, bi, kf, ki, scanned, scan_order, cmd, w,
+                         h, hit_p, hit_h)
 
 
 class TechBots:

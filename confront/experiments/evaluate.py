@@ -175,14 +175,20 @@ def sim_bot_battle(scenario: str, robots: list[str], rounds: int, seed: int, n_b
 
     ``n_battles = 1`` plays one battle of ``rounds`` rounds as Robocode does (robots such as Corners remember
     across rounds; with the engine's seed the start positions and processing order are the engine's); more
-    battles split the rounds for speed (battle b is seeded ``seed + b``).
+    battles split the rounds for speed (battle b is seeded ``seed + b``). Technique robots (``confront.arena.tech``)
+    keep their battle memory for 35 rounds, as the Java robots' static fields live for a RoboRumble battle.
     """
     from confront.arena.bots import bot_battle
     from confront.arena.scoring import results_table
+    from confront.arena.tech import TECH_ROBOTS, tech_battle
 
     sc = scenario_of(scenario)
     team = np.asarray(sc.team_ids())
-    parts, places = bot_battle(_robot_names(sc, robots), rounds, seed=seed, n_battles=n_battles, scenario=sc)
+    names = _robot_names(sc, robots)
+    if any(n in TECH_ROBOTS for n in names):
+        parts, places, _ = tech_battle(names, rounds, seed=seed, n_battles=n_battles, scenario=sc)
+    else:
+        parts, places = bot_battle(names, rounds, seed=seed, n_battles=n_battles, scenario=sc)
     labels = [name if size == 1 else f"{name} team {k}"
               for k, (name, size) in enumerate(zip(robots, sc.teams, strict=True))]
     return results_table(parts, places, team, labels, rounds=rounds)
@@ -248,14 +254,17 @@ def battle_cli(scenario: str, robots: str | None, engine: str, rounds: int, seed
     sc = scenario_of(scenario)
     from confront.arena.bots import BOT_NAMES
     from confront.arena.scenarios import SAMPLE_TEAMS
+    from confront.arena.tech import TECH_ROBOTS
 
     default = [("SpinBot", "Walls", "Tracker", "RamFire", "Crazy", "Fire", "Corners", "SittingDuck")[i % 8]
                for i in range(len(sc.teams))]
     names = [r.strip() for r in robots.split(",")] if robots else default
     for n in names:
-        if n not in BOT_NAMES and n not in SAMPLE_TEAMS:
-            raise click.UsageError(f"unknown robot {n!r}: use {', '.join(BOT_NAMES)} or a sample team "
-                                   f"({', '.join(SAMPLE_TEAMS)})")
+        if n not in BOT_NAMES and n not in SAMPLE_TEAMS and n not in TECH_ROBOTS:
+            raise click.UsageError(f"unknown robot {n!r}: use {', '.join(BOT_NAMES)}, a sample team "
+                                   f"({', '.join(SAMPLE_TEAMS)}) or a technique robot ({', '.join(TECH_ROBOTS)})")
+    if replay_out is not None and any(n in TECH_ROBOTS for n in names):
+        raise click.UsageError("--replay records battles of sample robots only")
     if battles < 1:
         raise click.UsageError(f"--battles must be >= 1, got {battles}")
     if engine == "robocode":

@@ -74,3 +74,22 @@ def test_shares_in_the_simulator_are_the_engines(install: EngineInstall, robots:
     sim = parts.sum(axis=1)
     assert min(eng) > 0 or min(sim) > 0
     assert abs(eng[0] / sum(eng) - sim[0] / sim.sum()) <= 0.02
+
+
+def test_confront_battle_plays_them_by_name_alike_in_both(install: EngineInstall) -> None:
+    """``confront battle --robots SurfVG,SpinBot``: the simulator's table is Robocode's, every number."""
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+
+    tables = []
+    for engine in ("sim", "robocode"):
+        res = CliRunner().invoke(cli, ["battle", "--robots", "SurfVG,SpinBot", "--rounds", "3", "--seed", "1",
+                                       "--engine", engine])
+        assert res.exit_code == 0, res.output
+        tables.append([[c.strip() for c in row.split("|")[3:-1]] for row in res.output.splitlines()
+                       if row.startswith("| ") and row[2].isdigit()])
+    assert len(tables[0]) == 2 and float(tables[0][0][0]) > 0
+    assert tables[0] == tables[1]
+    res = CliRunner().invoke(cli, ["battle", "--robots", "SurfVG,SpinBot", "--replay", "x.json"])
+    assert res.exit_code == 2 and "sample robots only" in res.output

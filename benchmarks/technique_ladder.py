@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import json
 
 import numpy as np
+from technique_shares import emit  # benchmarks/technique_shares.py
 
 from confront.arena.scenarios import get_scenario
 from confront.arena.tech import TECH_ROBOTS, tech_battle
@@ -46,10 +46,7 @@ def main() -> int:
         row = {"robot": r, "aps_vs_technique": round(float(np.mean([pair[r, o] for o in robots if o != r])), 4),
                "vs_samples": round(float(np.mean([share(r, s, args.rounds, seeds) for s in SAMPLES])), 4),
                "pairs": {o: round(pair[r, o], 3) for o in robots if o != r}}
-        print(json.dumps(row), flush=True)
-        if args.out:
-            with open(args.out, "a") as f:
-                f.write(json.dumps(row) + "\n")
+        emit(row, args.out)
     return 0
 
 

@@ -13,35 +13,13 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from dataclasses import dataclass
 
 import numpy as np
+from sample_shares import Matchup, shares  # benchmarks/sample_shares.py: the same matchups and shares
 
 from confront.arena.scenarios import get_scenario
 from confront.arena.tech import tech_battle
-from confront.engine.battle import BattleSpec, Team
 from confront.engine.runner import EngineOptions, run_battle
-
-
-@dataclass(frozen=True)
-class Matchup:
-    """Contestants as tuples of robot names (one name: a single robot; more: a team)."""
-
-    name: str
-    contestants: tuple[tuple[str, ...], ...]
-
-    @property
-    def robots(self) -> list[str]:
-        return [r for c in self.contestants for r in c]
-
-    @property
-    def teams(self) -> tuple[int, ...]:
-        return tuple(len(c) for c in self.contestants)
-
-    def spec(self, rounds: int) -> BattleSpec:
-        conts: list[str | Team] = [c[0] if len(c) == 1 else Team(f"T{k}{c[0]}", c)
-                                   for k, c in enumerate(self.contestants)]
-        return BattleSpec(tuple(conts), rounds=rounds)
 
 
 def _duel(a: str, b: str) -> Matchup:
@@ -80,13 +58,6 @@ def engine(m: Matchup, rounds: int, seed: int, cpu_ms: float) -> tuple[dict, lis
     return run.summary, list(run.round_turns), time.time() - t
 
 
-def shares(totals: np.ndarray, teams: tuple[int, ...]) -> list[float]:
-    """Score share (%) of each contestant."""
-    edges = np.cumsum((0,) + teams)
-    per = np.array([totals[a:b].sum() for a, b in zip(edges[:-1], edges[1:], strict=True)])
-    return (100 * per / per.sum()).tolist()
-
-
 def compare(m: Matchup, rounds: int, seed: int, cpu_ms: float) -> dict:
     """One matchup and seed in both: shares, their largest difference, identical rounds."""
     sim_tot, sim_len = simulate(m, rounds, seed)
@@ -104,25 +75,26 @@ def compare(m: Matchup, rounds: int, seed: int, cpu_ms: float) -> dict:
             "same_length_rounds": same, "skipped": sum(summ["skipped_turns"].values()), "engine_wall_s": round(wall, 1)}
 
 
+def emit(row: dict, out: str) -> None:
+    """Print a result row as JSON; also append it to ``out`` unless empty."""
+    print(json.dumps(row), flush=True)
+    if out:
+        with open(out, "a") as f:
+            f.write(json.dumps(row) + "\n")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=100)
     ap.add_argument("--seeds", default="1,2,3")
-    ap.add_argument("--only", default="")
+    ap.add_argument("--only", default="", help="comma list of matchup names (default: all)")
     ap.add_argument("--out", default="")
     ap.add_argument("--cpu-ms", type=float, default=50.0, help="engine CPU constant: generous, so no turn is skipped")
     args = ap.parse_args()
-    seeds = [int(x) for x in args.seeds.split(",")]
-    only = [x for x in args.only.split(",") if x]
-    for m in MATCHUPS:
-        if only and not any(o == m.name for o in only):
-            continue
-        for seed in seeds:
-            row = compare(m, args.rounds, seed, args.cpu_ms)
-            print(json.dumps(row), flush=True)
-            if args.out:
-                with open(args.out, "a") as f:
-                    f.write(json.dumps(row) + "\n")
+    only = set(filter(None, args.only.split(",")))
+    for m in (m for m in MATCHUPS if not only or m.name in only):
+        for seed in map(int, args.seeds.split(",")):
+            emit(compare(m, args.rounds, seed, args.cpu_ms), args.out)
     return 0
 
 

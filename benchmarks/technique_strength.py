@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+from technique_shares import emit  # benchmarks/technique_shares.py
 
 from confront.engine.battle import BattleSpec
 from confront.engine.runner import EngineOptions, run_battle
@@ -50,10 +51,7 @@ def main() -> int:
                               "share": round(got[-1], 4)}), flush=True)
         row = {"robot": args.robot, "opponent": opp, "mean_share": round(float(np.mean(got)), 4),
                "min_share": round(min(got), 4), "seeds": len(got)}
-        print(json.dumps(row), flush=True)
-        if args.out:
-            with open(args.out, "a") as f:
-                f.write(json.dumps(row) + "\n")
+        emit(row, args.out)
     return 0
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 import struct
 from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 from numba import njit
@@ -37,7 +38,7 @@ from .rules import java_atan2, java_hypot, java_next_double, java_seed, normal_r
 from .scenarios import Scenario
 from .strictmath import strict_cos, strict_sin
 
-__all__ = ["TECH_ROBOTS", "TechBots", "tech_kind", "tech_battle"]
+__all__ = ["TECH_ROBOTS", "TechBots", "tech_kind", "tech_battle", "poses_per_turn"]
 
 G_HEAD, G_LINEAR, G_CIRCULAR, G_GF, G_VIRTUAL = range(5)
 MV_ORBIT, MV_STOPGO, MV_RAM, MV_SURF, MV_RISK = range(5)
@@ -711,3 +712,29 @@ def tech_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 1
             if again.any():
                 arena.reset(again)
     return s.score_total.sum(axis=0), s.placements_total.sum(axis=0), lengths
+
+
+class _Driver(Protocol):
+    def commands(self, cmd: np.ndarray) -> np.ndarray: ...
+
+
+def poses_per_turn(arena: Arena, drivers: Sequence[_Driver], lengths: Sequence[int]) -> list[np.ndarray]:
+    """Battle 0's robots turn by turn, for comparison with a recorded engine battle of rounds of ``lengths`` turns:
+    per round (T, R, 7) x, y, body / gun / radar heading, velocity, energy after each turn (a round that ends
+    sooner stops there). ``drivers`` fill their robots' commands every turn (e.g. ScriptedBots, TechBots)."""
+    cmd = arena.idle_commands()
+    s = arena.state
+    out = []
+    for n in lengths:
+        rows = []
+        for _ in range(n):
+            for d in drivers:
+                d.commands(cmd)
+            arena.step(cmd)
+            rows.append(np.stack([s.x[0], s.y[0], s.heading[0], s.gun_heading[0], s.radar_heading[0],
+                                  s.velocity[0], s.energy[0]], 1))
+            if s.done[0]:
+                arena.reset(s.done.copy())
+                break
+        out.append(np.array(rows))
+    return out

@@ -18,7 +18,7 @@ from confront.arena.bots import BOT_NAMES, ScriptedBots
 from confront.arena.core import Arena
 from confront.arena.scenarios import get_scenario
 from confront.arena.strictmath import strict_cos, strict_sin
-from confront.arena.tech import TECH_ROBOTS, TechBots
+from confront.arena.tech import TECH_ROBOTS, TechBots, poses_per_turn
 
 TRACES = Path(__file__).parents[1] / "fixtures" / "traces" / "tech"
 FIXTURES = sorted(p.stem for p in TRACES.glob("*.jsonl"))
@@ -40,22 +40,7 @@ def _replay(name: str, forget_between_rounds: bool = False) -> tuple[list[np.nda
     samples = ScriptedBots(arena, [n if n in BOT_NAMES else None for n in names])
     tech = TechBots(arena, [n if n in TECH_ROBOTS else None for n in names], rounds_per_battle=1 if
                     forget_between_rounds else 35)
-    cmd = arena.idle_commands()
-    s = arena.state
-    sims = []
-    for rnd in eng:
-        sim = []
-        for _ in range(len(rnd)):
-            samples.commands(cmd)
-            tech.commands(cmd)
-            arena.step(cmd)
-            sim.append(np.stack([s.x[0], s.y[0], s.heading[0], s.gun_heading[0], s.radar_heading[0],
-                                 s.velocity[0], s.energy[0]], 1))
-            if s.done[0]:
-                arena.reset(s.done.copy())
-                break
-        sims.append(np.array(sim))
-    return eng, sims
+    return eng, poses_per_turn(arena, [samples, tech], [len(r) for r in eng])
 
 
 def _first_difference(eng: np.ndarray, sim: np.ndarray) -> int:

@@ -357,7 +357,9 @@ def export_replays(source: str | Path, out_dir: str | Path | None = None, gif: b
     written: list[Path] = []
     files = find_replays(source)
     if not files:
-        raise ValueError(f"no *.replay.json[.gz] files under {str(source)!r}")
+        raise ValueError(f"no *.replay.json[.gz] files under {str(source)!r}: a run records the last round of its "
+                         "trained team in replays/ when train.replay = true (the default), and confront battle "
+                         "--replay FILE records a battle")
     for f in files:
         rep = load_replay(f)
         stem = f.name

@@ -196,6 +196,7 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
      "t.jar"),
     # issue 34 frictions: export --out x.zip made a folder named x.zip
     ("export to a .zip", ["export", "{ws}/run", "--out", "{ws}/x.zip"], "must be a robots folder", "x.zip"),
+    ("replay of a run without replays", ["replay", "{ws}/adir"], "train.replay = true", None),
     ("replay --out onto a file", ["replay", "{ws}/nokeys.replay.json", "--out", "{ws}/afile"], "--out", None),
     # issue 34 item 11: scenarios too big for memory, and team sizes that are not whole numbers
     ("scenario of 6000 robots", ["train", "--set", "arena.scenario={ws}/crowd.toml", "--out", "{ws}/new"],

@@ -80,19 +80,20 @@ import numpy as np
 
 from confront.config import ConfigError
 
-from . import _kernels as K
+from . import kernels as K
+from .kernel_cache import entry
 from .rules import java_next_double, java_seed
 from .scenarios import Scenario, get_scenario
 from .state import FIELDS, HIT_BY_BULLET_SLOTS, ArenaState, allocate
 
-__all__ = ["Arena", "ORDER_MODES"]
+__all__ = ["Arena", "ORDER_MODES", "thread_pool", "run_parallel", "default_threads"]
 
 ORDER_MODES = {"engine": 0, "shuffle": 1, "fixed": 2}
 _PARALLEL_MIN_BATTLES = 16
 
 
 @cache
-def _pool(workers: int) -> ThreadPoolExecutor:
+def thread_pool(workers: int) -> ThreadPoolExecutor:
     """Shared worker threads for the GIL-free kernel."""
     return ThreadPoolExecutor(max_workers=workers, thread_name_prefix="arena")
 
@@ -158,17 +159,16 @@ class Arena:
         if scenario.initial_positions is not None:
             fixed = np.array(scenario.initial_positions, dtype=np.float64)
             fixed[:, 2] = np.radians(fixed[:, 2])
-            self._fixed, self._has_fixed = fixed, True
+            self.settings = K.Settings(self.params, fixed, True)
         else:
-            self._fixed, self._has_fixed = np.zeros((r, 3)), False
+            self.settings = K.Settings(self.params, np.zeros((r, 3)), False)
         width = max(r, self.state.n_bullet_slots) + 1
-        self._scratch_i = np.zeros((b, 6, width), dtype=np.int32)
-        self._scratch_f = np.zeros((b, 9, r), dtype=np.float64)
-        self._scratch_f[:, [K.TRIG_RADAR, K.TRIG_BODY]] = np.nan  # no sin/cos kept yet (_kernels._sin_cos)
-        p = self.state.packed
-        self._args = ((p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
-                       p["scan_time"], p["scan_order"], p["damage_ledger"], p["score"], p["score_total"],
-                       p["placements"], p["placements_total"]), (self.params, self._scratch_i, self._scratch_f))
+        self.scratch = K.Scratch(np.zeros((b, 6, width), dtype=np.int32), np.zeros((b, 9, r), dtype=np.float64))
+        self.scratch.floats[:, [K.TRIG_RADAR, K.TRIG_BODY]] = np.nan  # no sin/cos kept yet (kernels._sin_cos)
+        # the kernels' state: robots, battles, bullets, radar, scores (views of ``state``'s packed arrays)
+        self.bundles = self.state.bundles()
+        self._step_entry: Callable[..., Any] | None = None
+        self._reset_entry: Callable[..., Any] | None = None
         self.seed(seed)
         self.reset()
 
@@ -188,7 +188,7 @@ class Arena:
 
     def _battle_start(self, idx: np.ndarray) -> None:
         """The engine draws 3 doubles per entry of a fixed initial-positions string (Battle.computeInitialPositions)."""
-        if not self._has_fixed:
+        if not self.settings.has_fixed:
             return
         for b in idx:
             r = int(self.state.rng[b])
@@ -206,12 +206,12 @@ class Arena:
 
     def reset(self, mask: np.ndarray | None = None) -> None:
         """Start a new round in the masked battles (all if None); totals carry over."""
-        p = self.state.packed
         idx = self._mask(mask).astype(np.int64)
         if idx.size:
-            K.reset_many(idx, p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"],
-                         p["scanned"], p["scan_time"], p["damage_ledger"], p["score"], p["placements"],
-                         self.params, self._fixed, self._has_fixed, self._scratch_i)
+            args = (idx, *self.bundles, self.settings)
+            if self._reset_entry is None:
+                self._reset_entry = entry(K.reset_many, *args)
+            self._reset_entry(*args)
 
     def new_battle(self, mask: np.ndarray | None = None) -> None:
         """Clear the masked battles' totals and round counters, then start a round."""
@@ -232,15 +232,16 @@ class Arena:
             cmd = np.ascontiguousarray(cmd)
         if not np.isfinite(cmd[..., 4].sum()):
             raise ValueError("commands[..., 4] (fire power) must be finite; use 0 for no fire")
-        head, tail = self._args
-        args = (*head, cmd, *tail)
+        args = (*self.bundles, cmd, self.settings, self.scratch)
         b, workers = self.n_battles, self.threads
+        if self._step_entry is None:
+            self._step_entry = entry(K.step_range, 0, b, *args)
         if b >= _PARALLEL_MIN_BATTLES and workers > 1:
             size = -(-b // workers)
-            run_parallel(_pool(workers), K.step_range, [(lo, min(b, lo + size), *args) for lo in range(0, b, size)],
-                         workers)
+            run_parallel(thread_pool(workers), self._step_entry,
+                         [(lo, min(b, lo + size), *args) for lo in range(0, b, size)], workers)
         else:
-            K.step_range(0, b, *args)
+            self._step_entry(0, b, *args)
 
     def idle_commands(self) -> np.ndarray:
         """Commands that keep every remaining value and do not fire."""

@@ -4,8 +4,8 @@
 (:data:`KERNEL_MODULES`) a :class:`KernelCache`, numba's cache with two changes:
 
 - The source stamp of every kernel is one digest of all kernel module files, not its own file's: numba stores a
-  caller with its callees compiled in (``_smdp_turns`` holds the turn of ``_kernels.py`` and the bots of
-  ``bots.py``), so an entry stamped with its own file alone would run old code after a callee's module changed.
+  caller with its callees compiled in (``smdp_turns`` holds the turn of ``kernels.py`` and the bots of
+  ``bots/``), so an entry stamped with its own file alone would run old code after a callee's module changed.
 - On a miss, the kernel is looked up in ``prebuilt/<PREBUILT>/``: numba's cache files of the kernels Python
   calls, compiled by ``scripts/build_kernels.py`` for the x86-64-v3 CPU level (AVX2, FMA, BMI2; the same
   operations in the same order as the host's code: no fast-math, no fused multiply-add, so the same results bit
@@ -23,6 +23,7 @@ import json
 import os
 import platform
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -30,11 +31,14 @@ import numba
 from numba.core.caching import CompileResultCacheImpl, FunctionCache, IndexDataCacheFile
 from numba.core.dispatcher import Dispatcher
 
-__all__ = ["KERNEL_MODULES", "TARGET_CPU", "PREBUILT", "KernelCache", "install", "sources_digest", "prebuilt_dir"]
+__all__ = ["KERNEL_MODULES", "TARGET_CPU", "PREBUILT", "KernelCache", "install", "sources_digest", "prebuilt_dir",
+           "entry"]
 
 HERE = Path(__file__).resolve().parent
-# the modules whose code is compiled into the kernels (functions, and the constants they read)
-KERNEL_MODULES = ("rules", "state", "_kernels", "bots", "observe", "tank", "smdp_kernel")
+# the modules whose code is compiled into the kernels (functions, and the constants they read); every module of
+# bots/ (the controller and one per robot)
+KERNEL_MODULES = ("rules", "state", "kernels", *(f"bots.{p.stem}" for p in sorted((HERE / "bots").glob("*.py"))),
+                  "observe", "tank", "smdp_kernel")
 TARGET_CPU = "x86-64-v3"
 # LLVM's names of the x86-64-v2 and -v3 features (the x86-64 psABI levels)
 TARGET_FEATURES = ("cx16", "popcnt", "sahf", "sse3", "sse4.1", "sse4.2", "ssse3", "avx", "avx2", "bmi", "bmi2",
@@ -50,7 +54,7 @@ def sources_digest() -> str:
     h = hashlib.sha256()
     for name in KERNEL_MODULES:
         h.update(name.encode())
-        h.update((HERE / f"{name}.py").read_bytes())
+        h.update((HERE / f"{name.replace('.', '/')}.py").read_bytes())
     return h.hexdigest()
 
 
@@ -129,3 +133,10 @@ def install(namespace: dict[str, Any]) -> None:
         if isinstance(obj, Dispatcher) and obj.py_func.__module__ == module and isinstance(cache, FunctionCache) \
                 and not isinstance(cache, KernelCache):
             obj._cache = KernelCache(obj.py_func)  # type: ignore[attr-defined]
+
+
+def entry(kernel: Dispatcher, *args: Any) -> Callable[..., Any]:
+    """The compiled code of ``kernel`` for the types of ``args`` (loaded from the cache or compiled now), to call
+    without numba's type dispatch, which works out the types of NamedTuple bundles in Python (microseconds a call).
+    Every later call must pass arguments of the same types (the same arrays' dtypes, dimensions and layouts)."""
+    return kernel.compile(tuple(numba.typeof(a) for a in args))

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from .core import run_parallel
-from .smdp import LEARNER, SMDPConfig, StepResult, TeamBattleEnv, _pool, _smdp_turns
+from .smdp import LEARNER, SMDPConfig, StepResult, TeamBattleEnv, call_kernel, kernel_pool
 
 __all__ = ["PoolEntry", "PoolEnv", "PoolStep", "OpponentPolicy"]
 
@@ -128,7 +128,7 @@ class PoolEnv:
                 full[:, theirs] = np.asarray(entry.policy(d.reshape(-1), f.reshape(-1, f.shape[-1]), self.rng),
                                              dtype=np.int64).reshape(env.n_battles, -1)
             full_actions.append(full)
-        if any(env._recording is not None for env in self.envs):
+        if any(env.recording is not None for env in self.envs):
             results = [env.step(full) for env, full in zip(self.envs, full_actions, strict=True)]
         else:
             results = self._step_together(full_actions)
@@ -154,15 +154,16 @@ class PoolEnv:
 
     def _step_together(self, full_actions: list[np.ndarray]) -> list[StepResult]:
         """Every env's step (what ``env.step`` does) with all the kernels run together, largest first."""
-        begun = [env._begin(full) for env, full in zip(self.envs, full_actions, strict=True)]
-        workers = _pool()._max_workers
+        begun = [env.begin_step(full) for env, full in zip(self.envs, full_actions, strict=True)]
+        workers = kernel_pool()._max_workers
         whole = len(self.envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
         calls: list[tuple[int, tuple[Any, ...]]] = []
         for k, (env, (rewards, _, obs)) in enumerate(zip(self.envs, begun, strict=True)):
-            calls.extend((k, c) for c in env._kernel_calls(0, env.turns_per_step, rewards, obs, whole=whole))
+            calls.extend((k, c) for c in env.kernel_calls(0, env.turns_per_step, rewards, obs, whole=whole))
         calls.sort(key=lambda kc: -(kc[1][1] - kc[1][0]) * self.envs[kc[0]].n_robots)  # largest first
-        run_parallel(_pool(), _smdp_turns, [c for _, c in calls], workers)
-        return [env._finish(rewards, active, obs) for env, (rewards, active, obs) in zip(self.envs, begun, strict=True)]
+        run_parallel(kernel_pool(), call_kernel, [(self.envs[k].kernel(c), c) for k, c in calls], workers)
+        return [env.finish_step(rewards, active, obs)
+                for env, (rewards, active, obs) in zip(self.envs, begun, strict=True)]
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """Every env's state and the last observations (data only)."""

@@ -35,6 +35,7 @@ Default T = 10 turns: the paper gives no value; a 45-degree turn takes 5 turns a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -42,19 +43,21 @@ from typing import Any, Literal
 import numba
 import numpy as np
 
-from .bots import BOT_NAMES, ScriptedBots
+from .bots import BOT_NAMES, BotState, ScriptedBots
 from .control import N_MOVES, ControlConfig, move_commands, set_adjustments
 from .core import Arena, run_parallel
+from .kernel_cache import entry
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
 from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, opponent_members
-from .smdp_kernel import _prepare, _relative, _smdp_turns, controller_turn  # noqa: F401 - re-exported
+from .smdp_kernel import Outputs, Senses, Tanks, Views, prepare_actions, smdp_turns
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
 
 Reward = Literal["eq35", "score"]  # Eq. 35 per turn, or the change of the team's score margin
 
-__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS"]
+__all__ = ["SMDPConfig", "TeamBattleEnv", "StepResult", "RoundEnd", "resolve_drivers", "LEARNER", "REWARDS",
+           "kernel_pool", "call_kernel"]
 
 LEARNER = "td"  # opponents value meaning "learning tanks driven by the caller"
 REWARDS = {"eq35": 0, "score": 1}  # per-turn reward: Eq. 35 against the target, or the team's score margin
@@ -179,7 +182,7 @@ class TeamBattleEnv:
         self._cmd = self.arena.idle_commands()
         self._powers = np.asarray(self.config.fire_powers, dtype=np.float64)
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._recording: tuple[Replay, int] | None = None
+        self.recording: tuple[Replay, int] | None = None  # the replay being recorded and its battle
         b, r = self.n_battles, self.n_robots
         if opponent_actions not in ("same", "paper"):
             raise ValueError(f"opponent_actions must be 'same' or 'paper', got {opponent_actions!r}")
@@ -194,26 +197,23 @@ class TeamBattleEnv:
         self._memory = np.zeros((b, MEMORY_ROWS, r, r))  # each robot at each robot's last scan of it (tank.py)
         self._mates = np.zeros((b, 3, r))  # x, y, energy of every robot one turn ago (team messages, tank.py)
         self._mates_ok = np.zeros(b, dtype=np.bool_)  # False in a round's first turn: no message yet
-        self._sensing = SENSING[self.config.observation.sensing]
         self._turn_buf = np.zeros((4, b, r))  # per turn: target, own energy, target energy, live
-        self._kinds = self.bots.kinds.astype(np.int64) if self.bots is not None else np.zeros(r, np.int64)
-        self._rule = TARGET_RULES[self.config.observation.target]
         c = self.config.control
-        self._ctrl = np.array([c.radar_overshoot, c.aim_tolerance, c.power_near, c.power_mid, c.power_far,
-                               c.near_distance, c.far_distance, float(c.fire),
-                               float(REWARDS[self.config.reward])])
-        p, a = self.arena.state.packed, self.arena
+        ctrl = np.array([c.radar_overshoot, c.aim_tolerance, c.power_near, c.power_mid, c.power_far,
+                         c.near_distance, c.far_distance, float(c.fire), float(REWARDS[self.config.reward])])
+        self.tanks = Tanks(self.learner, self._move, self._power, self._chosen, ctrl,
+                            TARGET_RULES[self.config.observation.target], self.config.observation.reward_guard,
+                            SENSING[self.config.observation.sensing])
+        self.senses = Senses(self._memory, self._mates, self._mates_ok)
         threads = numba.get_num_threads()
         chunks = threads if b >= _PARALLEL_MIN_BATTLES and threads > 1 else 1
         size = -(-b // chunks)
         self._ranges = [(lo, min(b, lo + size)) for lo in range(0, b, size)]
         # each thread needs its own bots scratch (the bots' ``rem``)
-        self._rems = [np.zeros(4) for _ in self._ranges]
-        self._kargs = (p["rf"], p["rb"], p["ri"], p["bi"], p["bf"], p["bb"], p["kf"], p["ki"], p["scanned"],
-                       p["scan_time"], p["scan_order"], p["damage_ledger"], p["score"], p["score_total"],
-                       p["placements"], p["placements_total"], self._cmd, a.params, a._scratch_i, a._scratch_f,
-                       self.bots.mem if self.bots is not None else np.zeros((b, r, 1)))
-        self._kargs_end = (self.field[0], self.field[1], self._turn_buf)
+        kinds = self.bots.kinds if self.bots is not None else np.zeros(r, np.int64)
+        mem = self.bots.mem if self.bots is not None else np.zeros((b, r, 1))
+        self._bot_states = [BotState(kinds, mem, np.zeros(4)) for _ in self._ranges]
+        self._entry: Callable[..., int] | None = None
         # robots whose tank view is computed (a pool sets its caller-driven robots: nobody reads a bot's view)
         self.view_robots = np.ones(r, dtype=np.bool_)
         # robots whose paper observation (target, discrete state, paper features) is computed; the others get
@@ -352,12 +352,12 @@ class TeamBattleEnv:
             names = [f"{d or 'learner'}.{i}" for i, d in enumerate(self.drivers)]
         rep = new_replay(self.arena, names)
         record_frame(rep, self.arena, battle)
-        self._recording = (rep, battle)
+        self.recording = (rep, battle)
         return rep
 
     def stop_recording(self) -> Replay | None:
         """Stop recording; the replay recorded so far."""
-        rec, self._recording = self._recording, None
+        rec, self.recording = self.recording, None
         return None if rec is None else rec[0]
 
     # ------------------------------------------------------------------ stepping
@@ -377,24 +377,24 @@ class TeamBattleEnv:
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
-        rewards, active, obs = self._begin(actions)
-        if self._recording is None:
+        rewards, active, obs = self.begin_step(actions)
+        if self.recording is None:
             self._run_turns(0, self.config.turns_per_step, rewards, obs)
         else:
-            rep, b = self._recording
+            rep, b = self.recording
             for t in range(self.config.turns_per_step):
                 if self._run_turns(t, t + 1, rewards, obs) == t:
                     break
                 record_frame(rep, self.arena, b)
-        return self._finish(rewards, active, obs)
+        return self.finish_step(rewards, active, obs)
 
-    def _begin(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    def begin_step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
         """Checks and the learning tanks' moves for a step: (rewards, active, observation buffers) to fill."""
         a = self._check_actions(actions)
         T = self.config.turns_per_step
         active = np.empty((self.n_battles, self.n_robots), dtype=np.bool_)
         p = self.arena.state.packed
-        if _prepare(a, self._space, p["rb"], p["bb"], self._tables, self._n_act, self._slots, self._move,
+        if prepare_actions(a, self._space, p["rb"], p["bb"], self._tables, self._n_act, self._slots, self._move,
                     self._power, self._chosen, active):
             for space, who in ((0, "learning tanks"), (1, "caller-driven opponents")):
                 la = a[:, self._space == space]
@@ -409,31 +409,39 @@ class TeamBattleEnv:
                np.empty(shape + (self.n_features if self.config.tank is not None else 1,), np.float32))
         return rewards, active, obs
 
-    def _kernel_calls(self, t0: int, t1: int, rewards: np.ndarray, obs: tuple[np.ndarray, ...],
-                      whole: bool = False) -> list[tuple[Any, ...]]:
-        """Arguments of the compiled kernel for turns t0..t1-1, one tuple per battle range (one range for all
-        battles with ``whole``); the calls are independent (they release the GIL)."""
-        head = (t0, t1, self.learner, self._kinds, self.bots is not None, self._rule,
-                self.config.observation.reward_guard, self._move, self._power, self._chosen, self._ctrl,
-                self._memory, self._sensing)
+    def kernel_calls(self, t0: int, t1: int, rewards: np.ndarray, obs: tuple[np.ndarray, ...],
+                     whole: bool = False) -> list[tuple[Any, ...]]:
+        """Arguments of the compiled kernel (smdp_turns) for turns t0..t1-1, one tuple per battle range (one range
+        for all battles with ``whole``); the calls are independent (they release the GIL)."""
         tank = self.config.tank
-        view = (tank.enemy_slots, tank.mate_slots) if tank is not None else (0, 0)
-        tail = (rewards, self.max_distance, *obs, *view, self._mates, self._mates_ok, self._slots, self.view_robots,
-                self.paper_robots, self._group)
+        k_slots, m_slots = (tank.enemy_slots, tank.mate_slots) if tank is not None else (0, 0)
+        target, disc, feats, view = obs
+        out = Outputs(self._turn_buf, rewards, target, disc, feats, view, self._slots)
+        views = Views(self.max_distance, self.field[0], self.field[1], k_slots, m_slots,
+                      np.ascontiguousarray(self.view_robots, dtype=np.bool_),
+                      np.ascontiguousarray(self.paper_robots, dtype=np.bool_), self._group)
+        a = self.arena
         ranges = [(0, self.n_battles)] if whole else self._ranges
-        calls = [(lo, hi, *head, *self._kargs, self._rems[k], *self._kargs_end, *tail)
-                 for k, (lo, hi) in enumerate(ranges)]
-        return calls
+        return [(lo, hi, t0, t1, *a.bundles, self._cmd, a.settings, a.scratch, self._bot_states[k],
+                 self.bots is not None, self.tanks, self.senses, out, views) for k, (lo, hi) in enumerate(ranges)]
+
+    def kernel(self, call: tuple[Any, ...]) -> Callable[..., int]:
+        """smdp_turns compiled for the types of this env's calls (looked up once: numba's own dispatch would work
+        out the types of the bundles at every call)."""
+        if self._entry is None:
+            self._entry = entry(smdp_turns, *call)
+        return self._entry
 
     def _run_turns(self, t0: int, t1: int, rewards: np.ndarray, obs: tuple[np.ndarray, ...]) -> int:
         """Turns t0..t1-1 of the SMDP step in the compiled kernel (then observations into ``obs``);
         battle ranges run in parallel threads when there are enough battles."""
-        calls = self._kernel_calls(t0, t1, rewards, obs)
+        calls = self.kernel_calls(t0, t1, rewards, obs)
+        fn = self.kernel(calls[0])
         if len(calls) == 1:
-            return _smdp_turns(*calls[0])
-        return min(run_parallel(_pool(), _smdp_turns, calls, len(calls)))
+            return int(fn(*calls[0]))
+        return min(run_parallel(kernel_pool(), call_kernel, [(fn, c) for c in calls], len(calls)))
 
-    def _finish(self, rewards: np.ndarray, active: np.ndarray, obs: tuple[np.ndarray, ...]) -> StepResult:
+    def finish_step(self, rewards: np.ndarray, active: np.ndarray, obs: tuple[np.ndarray, ...]) -> StepResult:
         s = self.arena.state.arrays
         target, disc, paper, view = obs
         feats = view if self.config.tank is not None else paper
@@ -512,8 +520,13 @@ _PARALLEL_MIN_BATTLES = 8
 _POOL: list[ThreadPoolExecutor] = []
 
 
-def _pool() -> ThreadPoolExecutor:
+def kernel_pool() -> ThreadPoolExecutor:
     """A shared thread pool (the kernel releases the GIL)."""
     if not _POOL:
         _POOL.append(ThreadPoolExecutor(max(1, numba.get_num_threads())))
     return _POOL[0]
+
+
+def call_kernel(fn: Callable[..., int], call: tuple[Any, ...]) -> int:
+    """``fn(*call)`` (a kernel and its arguments, for a thread pool)."""
+    return fn(*call)

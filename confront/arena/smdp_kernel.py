@@ -1,6 +1,11 @@
 """The compiled SMDP step of :class:`confront.arena.smdp.TeamBattleEnv`: the learning tanks' moves
-(``_prepare``), the gun/radar controller (``controller_turn``) and T turns of battles with rewards and
-observations (``_smdp_turns``).
+(``prepare_actions``), the gun/radar controller (``controller_turn``) and T turns of battles with rewards and
+observations (``smdp_turns``).
+
+``smdp_turns`` takes the arena's bundles (:mod:`confront.arena.state`'s robots, battles, bullets, radar, scores;
+:mod:`confront.arena.kernels`' settings and scratch), the scripted robots' :class:`~confront.arena.bots.BotState`
+and four of its own: :class:`Tanks` (the learning tanks' step), :class:`Senses` (what the robots know),
+:class:`Outputs` (what the step writes) and :class:`Views` (which observations, of what size).
 
 A module of its own so that the Python side of the env (smdp.py) can change without recompiling the kernel;
 its numba cache is stamped with all kernel modules' sources (kernel_cache.py), as it holds their code.
@@ -8,24 +13,80 @@ its numba cache is stamped with all kernel modules' sources (kernel_cache.py), a
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from . import _kernels as K
-from .bots import bots_step
+from . import kernels as K
+from .bots.controller import bots_step
 from .kernel_cache import install
 from .observe import float_mod, perceive_row, remember_scans, reward_eq35_scalar, robot_observation, target_of
 from .rules import java_atan2, java_hypot
-from .state import HIT_BY_BULLET_SLOTS, HIT_ROBOT_SLOTS
 from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
+
+__all__ = ["Tanks", "Senses", "Outputs", "Views", "prepare_actions", "relative_angle", "controller_turn",
+           "smdp_turns"]
 
 C_OVERSHOOT, C_TOL, C_PNEAR, C_PMID, C_PFAR, C_NEAR, C_FAR, C_FIRE, C_REWARD = range(9)
 
 
+class Tanks(NamedTuple):
+    """The learning tanks' step: who learns (R,), each robot's move (B, R, 4: distance, body turn, 1 = turn
+    relative to the target, lead), fire power (B, R) and chosen target (B, R) (-1: by rule), the controller's
+    settings (C_*), the target rule, Eq. 35's guard and the sensing mode (observe.SENSING)."""
+
+    learner: np.ndarray
+    move: np.ndarray
+    power: np.ndarray
+    chosen: np.ndarray
+    ctrl: np.ndarray
+    rule: int
+    guard: float
+    sensing: int
+
+
+class Senses(NamedTuple):
+    """What the robots know: each robot at each robot's last scan (B, MEMORY_ROWS, R, R; tank.py), the team messages
+    (x, y, energy of every robot one turn ago, (B, 3, R)) and whether a message came yet (B,)."""
+
+    memory: np.ndarray
+    mates: np.ndarray
+    mates_ok: np.ndarray
+
+
+class Outputs(NamedTuple):
+    """What a step writes: the per-turn scratch (4, B, R), rewards (B, R, T), the paper's observations (target,
+    discrete state (B, R), features (B, R, F)), the tank views (B, R, view F) and their enemy slots (B, R, K)."""
+
+    buf: np.ndarray
+    rewards: np.ndarray
+    target: np.ndarray
+    disc: np.ndarray
+    feats: np.ndarray
+    view: np.ndarray
+    slots: np.ndarray
+
+
+class Views(NamedTuple):
+    """Which observations a step computes and their sizes: the paper's distance scale, the field, the tank view's
+    enemy and mate slots (0: no tank view), the robots whose tank view / paper observation is computed (R,), and
+    the battles stepped together (TeamBattleEnv.battle_group)."""
+
+    max_distance: float
+    width: float
+    height: float
+    k_slots: int
+    m_slots: int
+    view_mask: np.ndarray
+    paper_mask: np.ndarray
+    group: int
+
+
 @njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
-def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndarray, tables: np.ndarray,
-             n_act: np.ndarray, slots: np.ndarray, move: np.ndarray, power: np.ndarray, chosen: np.ndarray,
-             active: np.ndarray) -> bool:
+def prepare_actions(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndarray, tables: np.ndarray,
+                    n_act: np.ndarray, slots: np.ndarray, move: np.ndarray, power: np.ndarray, chosen: np.ndarray,
+                    active: np.ndarray) -> bool:
     """Learning tanks' move (distance, body turn), fire power and chosen target robot for the step (from
     their action table and the enemy slots of their last view), and ``active`` (a learning tank alive in a
     battle not done). Returns True, changing nothing, if an action is out of range."""
@@ -51,7 +112,7 @@ def _prepare(actions: np.ndarray, space: np.ndarray, rb: np.ndarray, bb: np.ndar
 
 
 @njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed
-def _relative(a: float) -> float:
+def relative_angle(a: float) -> float:
     """Angle wrapped to [-pi, pi) (Utils.normalRelativeAngle, as control._rel)."""
     return float_mod(a + np.pi, 2 * np.pi) - np.pi
 
@@ -75,8 +136,8 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
     dy = ty - rf[b, K.Y, i]
     bearing = java_atan2(dx, dy)  # absolute angle to the target, 0 = north, clockwise (Math.atan2's bits)
     dist = java_hypot(dx, dy)
-    gun_turn = _relative(bearing - rf[b, K.GH, i])
-    radar_turn = _relative(bearing - rf[b, K.RH, i])
+    gun_turn = relative_angle(bearing - rf[b, K.GH, i])
+    radar_turn = relative_angle(bearing - rf[b, K.RH, i])
     radar_turn = radar_turn + np.sign(radar_turn) * ctrl[C_OVERSHOOT]
     cmd[b, i, 2] = gun_turn
     cmd[b, i, 3] = radar_turn
@@ -93,25 +154,9 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
         cmd[b, i, 4] = ctrl[C_PFAR]
 
 
-@njit(cache=True, nogil=True, _nrt=False)
-def _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem):
-    """The scripted bots' decisions of battles b0..b1-1 (bots.bots_step on the arena's packed arrays)."""
-    r = slice(b0, b1)
-    bots_step(kinds, mem[r], rf[r, K.X], rf[r, K.Y], rf[r, K.H], rf[r, K.GH], rf[r, K.RH], rf[r, K.E],
-              rb[r, K.ALIVE], ri[r, K.TEAM], rf[r, K.DIST], rf[r, K.BODYREM], rf[r, K.GUNREM],
-              rf[r, K.RADREM], rf[r, K.MAXV], rf[r, K.ASSIST], rb[r, K.SCANREQ], scanned[r],
-              rb[r, K.EVWALL], ri[r, K.EVROBOT], rf[r, K.EVROBB], rb[r, K.EVFAULT], ri[r, K.EVHITBY],
-              rf[r, K.EVBULB], rf[r, K.EVBULH], rb[r, K.EVDIED], width, height, cmd[r], rem,
-              rf[r, K.EVROBN:K.EVROB0 + 4 * HIT_ROBOT_SLOTS], rf[r, K.EVBULN:K.EVBUL0 + 2 * HIT_BY_BULLET_SLOTS],
-              rf[r, K.HEAT], scan_order[r])
-
-
 @njit(cache=True, nogil=True)
-def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
-                rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
-                placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
-                rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
-                view_mask, paper_mask, group):
+def smdp_turns(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tanks,
+               senses, out, views):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
     per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of
@@ -123,25 +168,27 @@ def _smdp_turns(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, pow
     run in parallel threads. Each robot picks its target and aims from its own picture
     (observe.perceive_row); after each turn the robots' scans go into ``memory``. The battles are stepped in
     groups of ``group`` (TeamBattleEnv.battle_group); the results do not depend on it."""
-    n = rf.shape[2]
-    return _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory,
-                      sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
-                      score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width,
-                      height, buf, rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates,
-                      mates_ok, slots, view_mask, paper_mask, np.empty(n), np.empty(n), np.empty(n),
-                      np.empty(n, dtype=np.bool_), np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(feats.shape[2]),
-                      np.zeros(view.shape[2]), np.empty(n), group,
-                      np.empty(-(-(b1 - b0) // group), dtype=np.int64))
+    n = robots.f.shape[2]
+    return _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots,
+                      tanks, senses, out, views, np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_),
+                      np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]), np.zeros(out.view.shape[2]),
+                      np.empty(n), np.empty(-(-(b1 - b0) // views.group), dtype=np.int64))
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _smdp_turn(b0, b1, t, force, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
-               rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
-               placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf, rewards, k_slots,
-               mates, mates_ok, vx, vy, ve, va, before, gain):
+def _smdp_turn(b0, b1, t, force, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tanks,
+               senses, out, views, vx, vy, ve, va, before, gain):
     """Turn t of an SMDP step for battles b0..b1-1: the learning tanks' commands (battles done: buf[3] zero),
     then, unless every battle is done (and not ``force``), the bots, one Robocode turn, scan memory and rewards.
     Returns False when it stopped because every battle was done."""
+    rf, rb, ri = robots
+    bi, bb = battles.i, battles.b
+    scanned, scan_time = radar.scanned, radar.scan_time
+    score = scores.score
+    learner, move, power, chosen, ctrl, rule, guard, sensing = tanks
+    memory, mates, mates_ok = senses
+    buf, rewards = out.buf, out.rewards
+    width, height = views.width, views.height
     n = rf.shape[2]
     margin = ctrl[C_REWARD] > 0
     any_live = False
@@ -172,7 +219,7 @@ def _smdp_turn(b0, b1, t, force, learner, kinds, has_bots, rule, guard, move, po
                 cmd[b, i, 1] = move[b, i, 1] if t == 0 else np.nan
                 if t == 0 and move[b, i, 2] > 0 and tg >= 0:  # turn relative to the target's bearing
                     bearing = java_atan2(vx[tg] - rf[b, K.X, i], vy[tg] - rf[b, K.Y, i])
-                    cmd[b, i, 1] = _relative(bearing + move[b, i, 1] - rf[b, K.H, i])
+                    cmd[b, i, 1] = relative_angle(bearing + move[b, i, 1] - rf[b, K.H, i])
                 cmd[b, i, 2] = np.nan
                 cmd[b, i, 3] = np.nan
                 cmd[b, i, 4] = 0.0
@@ -192,8 +239,8 @@ def _smdp_turn(b0, b1, t, force, learner, kinds, has_bots, rule, guard, move, po
     if not any_live and not force:
         return False
     if has_bots:
-        _bots_range(b0, b1, kinds, mem, rf, rb, ri, scanned, scan_order, width, height, cmd, rem)
-    if k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
+        bots_step(b0, b1, bots, robots, radar, cmd, width, height)
+    if views.k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
         for b in range(b0, b1):
             mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
             for i in range(n):
@@ -203,9 +250,7 @@ def _smdp_turn(b0, b1, t, force, learner, kinds, has_bots, rule, guard, move, po
                 if margin:
                     before[b - b0, i] = score[b, i].sum()
     # one Robocode turn of these battles (what Arena.step runs)
-    K.step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
-                 score_total,
-                 placements, placements_total, cmd, params, scratch_i, scratch_f)
+    K.step_range(b0, b1, robots, battles, bullets, radar, scores, cmd, settings, scratch)
     for b in range(b0, b1):
         remember_scans(scanned[b], rf[b, K.X], rf[b, K.Y], rf[b, K.E], rf[b, K.H], rf[b, K.V],
                        float(bi[b, K.TIME]), memory[b])
@@ -229,14 +274,17 @@ def _smdp_turn(b0, b1, t, force, learner, kinds, has_bots, rule, guard, move, po
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory, sensing,
-               rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total, placements,
-               placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width, height, buf,
-               rewards, max_distance, target, disc, feats, view, k_slots, m_slots, mates, mates_ok, slots,
-               view_mask, paper_mask, vx, vy, ve, va, before, gain, row, vrow, dist, group, stops):
-    """:func:`_smdp_turns` with its scratch arrays given (vx, vy, ve, va, gain, dist (R,), before (b1 - b0, R),
+def _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tanks,
+               senses, out, views, vx, vy, ve, va, before, gain, row, vrow, dist, stops):
+    """:func:`smdp_turns` with its scratch arrays given (vx, vy, ve, va, gain, dist (R,), before (b1 - b0, R),
     row (F,), vrow (view F,) and stops (groups,)): no allocation, so no reference counting of the many views it
     passes on."""
+    rf, rb, ri = robots
+    bi, scan_time = battles.i, radar.scan_time
+    rule, sensing = tanks.rule, tanks.sensing
+    memory, mates, mates_ok = senses
+    target, disc, feats, view, slots = out.target, out.disc, out.feats, out.view, out.slots
+    max_distance, width, height, k_slots, m_slots, view_mask, paper_mask, group = views
     n = rf.shape[2]
     # battles in groups of ``group`` (their arrays stay in cache over the step's turns), each group turn by turn; a
     # group whose battles are all done stops, and once the step's last turn is known (the first turn at which every
@@ -248,11 +296,8 @@ def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, powe
         g1 = min(b1, g0 + group)
         stops[g] = t1
         for t in range(t0, t1):
-            if not _smdp_turn(g0, g1, t, False, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl,
-                              memory, sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger,
-                              score, score_total, placements, placements_total, cmd, params, scratch_i, scratch_f,
-                              mem, rem, width, height, buf, rewards, k_slots, mates, mates_ok, vx, vy, ve, va,
-                              before[g0 - b0:g1 - b0], gain):
+            if not _smdp_turn(g0, g1, t, False, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots,
+                              has_bots, tanks, senses, out, views, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain):
                 stops[g] = t
                 break
         t_end = max(t_end, stops[g])
@@ -260,10 +305,8 @@ def _smdp_core(b0, b1, t0, t1, learner, kinds, has_bots, rule, guard, move, powe
         g0 = b0 + g * group
         g1 = min(b1, g0 + group)
         for t in range(stops[g], t_end):
-            _smdp_turn(g0, g1, t, True, learner, kinds, has_bots, rule, guard, move, power, chosen, ctrl, memory,
-                       sensing, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score,
-                       score_total, placements, placements_total, cmd, params, scratch_i, scratch_f, mem, rem, width,
-                       height, buf, rewards, k_slots, mates, mates_ok, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain)
+            _smdp_turn(g0, g1, t, True, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots,
+                       tanks, senses, out, views, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain)
     # the paper's observations (observe.observe_kernel) of the robots in paper_mask; the others: target -1,
     # state 0, features 0
     for b in range(b0, b1):

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from .scenarios import Scenario
 
-__all__ = ["FIELDS", "GROUPS", "SINGLES", "ArenaState", "allocate", "bullet_capacity", "SCORE_PARTS", "N_SCORE"]
+__all__ = ["FIELDS", "GROUPS", "SINGLES", "ArenaState", "allocate", "bullet_capacity", "SCORE_PARTS", "N_SCORE",
+           "Robots", "Battles", "Bullets", "Radar", "Scores"]
 
 SCORE_PARTS = ("survival", "last_survivor", "bullet_damage", "bullet_kill_bonus", "ram_damage", "ram_kill_bonus")
 N_SCORE = len(SCORE_PARTS)
@@ -81,6 +83,48 @@ DEFAULTS: dict[str, float] = {
 FIELDS: tuple[str, ...] = tuple(f for g in GROUPS.values() for f in g[0]) + tuple(SINGLES)
 
 
+class Robots(NamedTuple):
+    """The per-robot groups (B, fields, R), fields in RF_FIELDS / RB_FIELDS / RI_FIELDS order: the kernels' robots."""
+
+    f: np.ndarray  # float64
+    b: np.ndarray  # bool
+    i: np.ndarray  # int32
+
+
+class Battles(NamedTuple):
+    """The per-battle groups (B, fields), in BI_FIELDS (the java.util.Random state first) / BF_FIELDS / BB_FIELDS
+    order."""
+
+    i: np.ndarray  # int64
+    f: np.ndarray  # float64
+    b: np.ndarray  # bool
+
+
+class Bullets(NamedTuple):
+    """The bullet list (B, fields, K), in KF_FIELDS / KI_FIELDS order."""
+
+    f: np.ndarray  # float64
+    i: np.ndarray  # int32
+
+
+class Radar(NamedTuple):
+    """Robot x robot scan arrays (B, R, R): this turn's scans, the turn of each last scan, each scanner's list order."""
+
+    scanned: np.ndarray
+    scan_time: np.ndarray
+    scan_order: np.ndarray
+
+
+class Scores(NamedTuple):
+    """This round's score parts and their totals (B, R, 6), placements (B, R, 3), the damage ledger (B, R, R)."""
+
+    score: np.ndarray
+    score_total: np.ndarray
+    placements: np.ndarray
+    placements_total: np.ndarray
+    ledger: np.ndarray
+
+
 def bullet_capacity(scenario: Scenario) -> int:
     """Bullet-list slots per battle: flying bullets, explosions and death explosions of all robots.
 
@@ -120,6 +164,13 @@ class ArenaState:
     @property
     def n_bullet_slots(self) -> int:
         return int(self.arrays["b_x"].shape[1])
+
+    def bundles(self) -> tuple[Robots, Battles, Bullets, Radar, Scores]:
+        """The packed arrays as the kernels take them (views: the kernels write the state)."""
+        p = self.packed
+        return (Robots(p["rf"], p["rb"], p["ri"]), Battles(p["bi"], p["bf"], p["bb"]), Bullets(p["kf"], p["ki"]),
+                Radar(p["scanned"], p["scan_time"], p["scan_order"]),
+                Scores(p["score"], p["score_total"], p["placements"], p["placements_total"], p["damage_ledger"]))
 
 
 def allocate(scenario: Scenario, n_battles: int) -> ArenaState:

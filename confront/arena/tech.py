@@ -31,7 +31,7 @@ from typing import Protocol
 import numpy as np
 from numba import njit
 
-from . import _kernels as K
+from . import kernels as K
 from .bots import teammate_masks
 from .core import Arena
 from .rules import java_atan2, java_hypot, java_next_double, java_seed, normal_relative_angle

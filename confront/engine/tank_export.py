@@ -129,7 +129,7 @@ def robot_target(x: float, y: float, enemies: Sequence[EnemyRow], chosen: int) -
 
 
 def _relative(a: float) -> float:
-    """Angle wrapped to [-pi, pi) (smdp._relative)."""
+    """Angle wrapped to [-pi, pi) (smdp_kernel.relative_angle)."""
     return float(float_mod(a + math.pi, 2 * math.pi)) - math.pi
 
 
@@ -143,7 +143,7 @@ def turn_rate(previous: EnemyRow | None, heading: float, time: float) -> float:
 
 def body_turn(space: TankSpace, x: float, y: float, heading: float, enemies: Sequence[EnemyRow], target: int,
               turn: float) -> float:
-    """The body turn commanded at a step's start for the action's ``turn`` (smdp._smdp_turns): with
+    """The body turn commanded at a step's start for the action's ``turn`` (smdp_kernel.smdp_turns): with
     ``turn_mode="target"`` and a target, the turn putting the body at that angle to the target's bearing from
     its last scanned position, wrapped to [-pi, pi); else ``turn``."""
     if space.turn_mode != "target" or target < 0:

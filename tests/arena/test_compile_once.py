@@ -8,8 +8,9 @@ import textwrap
 
 SCRIPT = textwrap.dedent("""
     import numpy as np
-    from confront.arena import bots, observe, smdp_kernel, tank
-    from confront.arena import _kernels as K
+    from confront.arena import observe, smdp_kernel, tank
+    from confront.arena.bots import controller, registry
+    from confront.arena import kernels as K
     from confront.arena.pool import PoolEntry, PoolEnv
     from confront.arena.smdp import SMDPConfig
     from confront.arena.tank import TankSpace
@@ -23,8 +24,8 @@ SCRIPT = textwrap.dedent("""
     rng = np.random.default_rng(0)
     for _ in range(3):
         pool.step(rng.integers(0, int(np.prod(pool.action_dims)), size=pool.n_agents))
-    for f in (K.step_range, K._step_battle, bots.bots_step, bots._bots_battle, bots._dispatch,
-              smdp_kernel._smdp_turns, observe.observe_kernel, observe.perceive_row, observe.target_of,
+    for f in (K.step_range, K._step_battle, controller.bots_step, controller.battle_step, controller.dispatch,
+              registry.act, smdp_kernel.smdp_turns, observe.observe_kernel, observe.perceive_row, observe.target_of,
               tank.tank_view_kernel, tank.tank_view_row):
         print(f.py_func.__name__, len(f.signatures))
 """)
@@ -34,4 +35,4 @@ def test_pool_kernels_compiled_once() -> None:
     out = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, check=True).stdout
     counts = dict(line.split() for line in out.strip().splitlines())
     # 0: loaded from numba's cache or the shipped kernels (kernel_cache.py), which hold a caller with its callees
-    assert counts["_smdp_turns"] == "1" and all(n in ("0", "1") for n in counts.values()), counts
+    assert counts["smdp_turns"] == "1" and all(n in ("0", "1") for n in counts.values()), counts

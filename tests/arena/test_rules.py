@@ -187,7 +187,7 @@ def _java_next_int_reference(state: int, bound: int) -> tuple[int, int]:
 
 
 def test_next_int_rejection_and_skip_match_java():
-    from confront.arena._kernels import shuffle_into, skip_shuffle
+    from confront.arena.kernels import shuffle_into, skip_shuffle
 
     perm = np.zeros(16, dtype=np.int32)
     for u in ((1 << 31) - 1, (1 << 31) - 3, (1 << 31) - 8, 5, 1 << 30):
@@ -203,7 +203,7 @@ def test_next_int_rejection_and_skip_match_java():
 
 def test_shuffle_and_skips_match_collections_shuffle():
     """shuffle_into and the jump-ahead skip equal Collections.shuffle step by step, also when a draw is rejected."""
-    from confront.arena._kernels import shuffle_into, skip_shuffle
+    from confront.arena.kernels import shuffle_into, skip_shuffle
 
     mult, mask = 0x5DEECE66D, (1 << 48) - 1
     back = pow(mult, -1, 1 << 48)

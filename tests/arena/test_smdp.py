@@ -131,10 +131,10 @@ def test_bad_input_errors() -> None:
 
 
 def test_compiled_controller_matches_control_module() -> None:
-    from confront.arena import _kernels as K
+    from confront.arena import kernels as K
     from confront.arena.control import ControlConfig, gun_radar_commands
     from confront.arena.observe import perceive
-    from confront.arena.smdp import controller_turn
+    from confront.arena.smdp_kernel import controller_turn
 
     env = TeamBattleEnv("4v4", n_battles=4, seed=8, opponents="td")
     env.reset()
@@ -153,7 +153,7 @@ def test_compiled_controller_matches_control_module() -> None:
         for i in range(8):
             t = int(tgt[b, i])
             if s.alive[b, i]:
-                controller_turn(rf, b, i, t, vx[b, i, t], vy[b, i, t], env._ctrl, 0.0, out)
+                controller_turn(rf, b, i, t, vx[b, i, t], vy[b, i, t], env.tanks.ctrl, 0.0, out)
                 stale += t >= 0 and (vx[b, i, t], vy[b, i, t]) != (s.x[b, t], s.y[b, t])
     # equal up to the last bit of arctan2 (NumPy's and LLVM's libm may differ by one ulp)
     np.testing.assert_allclose(out[..., :4], ref[..., :4], rtol=0, atol=1e-12)

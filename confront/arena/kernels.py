@@ -12,6 +12,7 @@ exactly as the engine consumes it; 1 = one shuffle of the movement order per tur
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -91,6 +92,22 @@ TRIG_RADAR, TRIG_BODY = 3, 6
 
 # params vector
 P_W, P_H, P_COOL, P_INACT, P_MAXT, P_AFTER, P_ORDER = range(7)
+
+
+class Settings(NamedTuple):
+    """An arena's fixed settings: the params vector (P_*), the scenario's initial positions (R, 3) if any."""
+
+    params: np.ndarray
+    fixed: np.ndarray
+    has_fixed: bool
+
+
+class Scratch(NamedTuple):
+    """Per-battle work arrays of the turn: ints (B, 6, max(R, K) + 1): robot and bullet orders, dead robots, bullet
+    list order, near flags; floats (B, 9, R): the ``last`` rows (TRIG_RADAR, TRIG_BODY)."""
+
+    ints: np.ndarray
+    floats: np.ndarray
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
@@ -752,9 +769,14 @@ def _clear_events(b, i, rb, ri, scanned, rf):
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
-def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
-                 placements, placements_total, cmd, params, perm_r, perm_k, perm_d, dead, last, order, near):
+def _step_battle(b, robots, battles, bullets, radar, scores, cmd, params, perm_r, perm_k, perm_d, dead, last, order,
+                 near):
     """One Robocode turn of battle b (Battle.runTurn)."""
+    rf, rb, ri = robots
+    bi, bf, bb = battles
+    kf, ki = bullets
+    scanned, scan_time, scan_order = radar
+    score, score_total, placements, placements_total, ledger = scores
     n = rf.shape[2]
     mode = int(params[P_ORDER])
     bi[b, TIME] += 1
@@ -921,31 +943,34 @@ def _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_ord
 
 
 @njit(cache=True, inline="always", _nrt=False, error_model="numpy")
-def step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
-                   placements, placements_total, cmd, params, scratch_i, scratch_f, n, k):
+def step_battle_at(b, robots, battles, bullets, radar, scores, cmd, settings, scratch):
     """_step_battle with battle b's rows of the scratch arrays."""
-    _step_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
-                 placements, placements_total, cmd, params, scratch_i[b, 0, :n], scratch_i[b, 1, :k],
-                 scratch_i[b, 2], scratch_i[b, 3, :n + 1], scratch_f, scratch_i[b, 4], scratch_i[b, 5])
+    n = robots.f.shape[2]
+    k = bullets.f.shape[2]
+    ints = scratch.ints
+    _step_battle(b, robots, battles, bullets, radar, scores, cmd, settings.params, ints[b, 0, :n], ints[b, 1, :k],
+                 ints[b, 2], ints[b, 3, :n + 1], scratch.floats, ints[b, 4], ints[b, 5])
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy", nogil=True)
-def step_range(b0, b1, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
-               placements, placements_total, cmd, params, scratch_i, scratch_f):
+def step_range(b0, b1, robots, battles, bullets, radar, scores, cmd, settings, scratch):
     """Advance battles b0 .. b1-1 that are not done by one turn."""
-    n = rf.shape[2]
-    k = kf.shape[2]
+    bb = battles.b
     for b in range(b0, b1):
         if bb[b, DONE]:
             continue
-        step_battle_at(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, scan_order, ledger, score, score_total,
-                       placements, placements_total, cmd, params, scratch_i, scratch_f, n, k)
+        step_battle_at(b, robots, battles, bullets, radar, scores, cmd, settings, scratch)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
-def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
-                 params, fixed, has_fixed, scratch_i):
+def reset_battle(b, robots, battles, bullets, radar, scores, settings):
     """Start a new round in battle b (RobotPeer.initializeRound): placement, energies, gun heat 3."""
+    rf, rb, ri = robots
+    bi, bf, bb = battles
+    kf, ki = bullets
+    scanned, scan_time = radar.scanned, radar.scan_time
+    score, placements, ledger = scores.score, scores.placements, scores.ledger
+    params, fixed, has_fixed = settings
     n = rf.shape[2]
     w = params[P_W]
     hgt = params[P_H]
@@ -1017,12 +1042,10 @@ def reset_battle(b, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, 
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
-def reset_many(idx, rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
-               params, fixed, has_fixed, scratch_i):
+def reset_many(idx, robots, battles, bullets, radar, scores, settings):
     """reset_battle for every battle index in idx."""
     for q in range(idx.shape[0]):
-        reset_battle(idx[q], rf, rb, ri, bi, bf, bb, kf, ki, scanned, scan_time, ledger, score, placements,
-                     params, fixed, has_fixed, scratch_i)
+        reset_battle(idx[q], robots, battles, bullets, radar, scores, settings)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")

@@ -64,7 +64,7 @@ class Outputs(NamedTuple):
     target: np.ndarray
     disc: np.ndarray
     feats: np.ndarray
-    view: np.ndarray
+    tank_view: np.ndarray
     slots: np.ndarray
 
 
@@ -171,8 +171,9 @@ def smdp_turns(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, set
     n = robots.f.shape[2]
     return _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots,
                       tanks, senses, out, views, np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_),
-                      np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]), np.zeros(out.view.shape[2]),
-                      np.empty(n), np.empty(-(-(b1 - b0) // views.group), dtype=np.int64))
+                      np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]),
+                      np.zeros(out.tank_view.shape[2]), np.empty(n),
+                      np.empty(-(-(b1 - b0) // views.group), dtype=np.int64))
 
 
 @njit(cache=True, nogil=True, _nrt=False)
@@ -283,7 +284,7 @@ def _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, set
     bi, scan_time = battles.i, radar.scan_time
     rule, sensing = tanks.rule, tanks.sensing
     memory, mates, mates_ok = senses
-    target, disc, feats, view, slots = out.target, out.disc, out.feats, out.view, out.slots
+    target, disc, feats, view, slots = out.target, out.disc, out.feats, out.tank_view, out.slots
     max_distance, width, height, k_slots, m_slots, view_mask, paper_mask, group = views
     n = rf.shape[2]
     # battles in groups of ``group`` (their arrays stay in cache over the step's turns), each group turn by turn; a

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from confront.arena.control import ControlConfig
+from confront.checkpoint import CheckpointError
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.tank import TankSpace
 from confront.engine.java_build import compile_java
@@ -350,7 +351,7 @@ def test_run_folder_loads(tmp_path) -> None:
     assert q.to_text().split("aim_tolerance")[0] == p.to_text().split("aim_tolerance")[0]
     tank = json.loads((tmp_path / "run" / "model" / "tank.json").read_text())
     (tmp_path / "run" / "model" / "tank.json").write_text(json.dumps({**tank, "dims": [2, 5, 4, 2, 2]}))
-    with pytest.raises(ValueError, match="dims"):
+    with pytest.raises(CheckpointError, match="dims"):
         load_tank_policy(tmp_path / "run")
 
 

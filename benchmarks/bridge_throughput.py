@@ -49,8 +49,8 @@ from confront.engine.bridged import BRIDGE_BOT, BRIDGE_CPU_CONSTANT_MS, BridgedR
 from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
-from confront.experiments.spec import ArenaSection
 from confront.learning.tabular import TabularQ
+from confront.train.spec import ArenaSection
 
 OPPONENTS = ("Walls", "Tracker", "SpinBot", "RamFire")
 STAND_IN = "Tracker"  # the sample robot that takes our place in the sample-only battle

@@ -71,8 +71,8 @@ def child() -> None:
                 st[-1][2] += dt
 
     event.register("numba:compile", Compiles())
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.tanks import TankTrainer
+    from confront.train.ppo_sim import TankTrainer
+    from confront.train.spec import load_experiment
 
     t1, c1 = time.perf_counter(), _cpu()
     trainer = TankTrainer(load_experiment("tanks-demo", ()))

@@ -37,10 +37,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from confront.engine.tank_export import evaluate_tank_policy, export_tank_robot, load_tank_policy
-from confront.experiments.spec import ExperimentConfig, load_experiment
-from confront.experiments.tanks_engine import TANK_CPU_CONSTANT_MS
-from confront.experiments.train import train_run
+from confront.engine.tank_export import TANK_CPU_CONSTANT_MS, evaluate_tank_policy, export_tank_robot, load_tank_policy
+from confront.train.factory import train_run
+from confront.train.spec import ExperimentConfig, load_experiment
 
 OPPONENT = "SpinBot"
 

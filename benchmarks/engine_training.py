@@ -54,14 +54,15 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import confront.experiments.train_engine as train_engine
 from confront.engine.bridged import BRIDGE_CPU_CONSTANT_MS
 from confront.engine.evaluate import exported_battle
 from confront.engine.export import export_robot
 from confront.engine.runner import EngineOptions
 from confront.experiments.evaluate import exported_policy
-from confront.experiments.spec import ExperimentConfig, load_experiment
-from confront.experiments.train import load_model, train_run
+from confront.train import paper_engine
+from confront.train.factory import train_run
+from confront.train.paper_model import load_model
+from confront.train.spec import ExperimentConfig, load_experiment
 
 ISSUE_SETTINGS = ("arena.scenario=1v1", "opponent.kind=SpinBot", "learner.kind=ssaq")
 OPPONENT = "SpinBot"
@@ -75,11 +76,11 @@ def _cpu() -> tuple[float, float]:
 
 @contextlib.contextmanager
 def _battles_of_training(one_cpu: bool | None = None) -> Iterator[list[dict[str, Any]]]:
-    """Time every battle the engine trainer plays (``run_bridged_battle`` as ``train_engine`` calls it) and keep
+    """Time every battle the engine trainer plays (``run_bridged_battle`` as ``paper_engine`` calls it) and keep
     what it needs to be replayed by the exported robot: rounds, engine seed, CPU constant, one-CPU setting
     (``one_cpu``: None keeps the trainer's, else forced on both sides)."""
     played: list[dict[str, Any]] = []
-    original = train_engine.run_bridged_battle
+    original = paper_engine.run_bridged_battle
 
     def timed(spec, policy, options=None, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
         if one_cpu is not None:
@@ -90,11 +91,11 @@ def _battles_of_training(one_cpu: bool | None = None) -> Iterator[list[dict[str,
                        "cpu_constant_ms": options.cpu_constant_ms, "one_cpu": options.one_cpu, "bridged": res})
         return res
 
-    train_engine.run_bridged_battle = timed
+    paper_engine.run_bridged_battle = timed
     try:
         yield played
     finally:
-        train_engine.run_bridged_battle = original
+        paper_engine.run_bridged_battle = original
 
 
 def _record(mode: str, rep: int, wall: float, cpu0: tuple[float, float], battles: list[dict[str, Any]],

@@ -9,7 +9,7 @@ random actions from the action space). Prints a table; with
 on a busy machine a steadier figure for single-threaded rows)).
 
 ``pool`` rows time ``PoolEnv.step`` alone (the PPO tanks' environment: tank view, tank actions, score
-reward, T = 5) over the league of ``confront/experiments/configs/tanks-demo.toml`` (5 entries x 24 battles)
+reward, T = 5) over the league of ``confront/train/configs/tanks-demo.toml`` (5 entries x 24 battles)
 and ``tanks.toml`` (22 entries x 12), random joint tank actions; ``batch`` = agents (learning tanks),
 ``steps_per_s`` x batch = learner decisions per second. The caller-driven opponents run their Python
 policies (dodge, strafe; a random-weight snapshot for ``self``), except the TD team: random paper moves
@@ -100,25 +100,26 @@ def bench_team(scenario: str, opponents: str, batch: int, turns: int, seconds: f
 def _league_pool(config: str):  # noqa: ANN202 - a PoolEnv
     """The PoolEnv of an experiment config's league (see the module docstring)."""
     from confront.arena.pool import PoolEntry, PoolEnv
-    from confront.experiments import tanks
-    from confront.experiments.spec import load_experiment
+    from confront.train import league
+    from confront.train.ppo_model import smdp_tank_config, tank_space
+    from confront.train.spec import load_experiment
 
     cfg = load_experiment(config)
-    space = tanks.tank_space(cfg)
-    snap = tanks.SnapshotPolicy(space.dims)
+    space = tank_space(cfg)
+    snap = league.SnapshotPolicy(space.dims)
     rng = np.random.default_rng(0)
     sizes = [space.n_features, 64, 64, sum(space.dims)]
     snap.load({f"{w}{i}": (rng.normal(0, 0.1, (sizes[i + 1], sizes[i])) if w == "w" else np.zeros(sizes[i + 1]))
                for i in range(3) for w in "wb"})
-    policies = {"td": tanks.random_policy, "random": tanks.random_policy, "dodge": tanks.dodge_policy,
-                "strafe": tanks.strafe_policy(space), "self": snap}
+    policies = {"td": league.random_policy, "random": league.random_policy, "dodge": league.dodge_policy,
+                "strafe": league.strafe_policy(space), "self": snap}
     entries = []
     for e in cfg.league.opponents:
         scen, _, opp = e.partition(":")
         pol = policies.get(opp)
         entries.append(PoolEntry(e, scen, "td" if pol is not None else opp, cfg.league.battles, policy=pol,
                                  opponent_actions="paper" if opp in ("td", "random", "dodge") else "same"))
-    return PoolEnv(entries, tanks.smdp_tank_config(cfg), seed=0)
+    return PoolEnv(entries, smdp_tank_config(cfg), seed=0)
 
 
 def bench_pool(config: str, seconds: float) -> dict:

@@ -69,10 +69,12 @@ def run_arm(arm: str, seed: int, rounds: int, overrides: tuple[str, ...],
     """(3, rounds // 10): per session of one arm at one seed, the score ratio, our tanks' mean Eq. 35 reward per
     SMDP step and their mean distance to the target (px); ``learner_params`` rebuild the DMNN; ``reward`` is what
     the learners are trained on (module docstring)."""
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import SMDPTrainer, run_rounds, session_rows, td_learner
     from confront.learning.factory import clone_learner, make_learner
     from confront.learning.transfer import Frozen
+    from confront.train.league import td_learner
+    from confront.train.loop import run_rounds, session_rows
+    from confront.train.paper_sim import SMDPTrainer
+    from confront.train.spec import load_experiment
 
     sets = [f"train.seed={seed}", f"train.rounds={rounds}", "train.replay=false", *overrides]
     if arm == "ssaq":

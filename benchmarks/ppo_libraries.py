@@ -19,8 +19,10 @@ import time
 
 import numpy as np
 
-from confront.experiments.spec import load_experiment
-from confront.experiments.tanks import TankTrainer, build_pool, evaluate_tanks, ppo_config
+from confront.experiments.tank_evaluate import evaluate_tanks
+from confront.train.league import build_pool
+from confront.train.ppo_sim import TankTrainer
+from confront.train.spec import load_experiment
 
 LEAGUE = ["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "4v4:SpinBot", "4v4:dodge"]
 
@@ -52,7 +54,7 @@ def sb3(decisions: int, hidden: int, battles: int, rounds: int) -> dict[str, obj
     torch.set_num_threads(1)
     cfg = _cfg(hidden, battles)
     pool, _ = build_pool(cfg, cfg.train.seed)
-    pc = ppo_config(cfg)
+    pc = cfg.ppo
     dims = pool.action_dims
 
     class PoolVecEnv(VecEnv):
@@ -136,7 +138,7 @@ def torchrl(decisions: int, hidden: int, battles: int, rounds: int) -> dict[str,
     torch.set_num_threads(1)
     cfg = _cfg(hidden, battles)
     pool, _ = build_pool(cfg, cfg.train.seed)
-    pc = ppo_config(cfg)
+    pc = cfg.ppo
     dims = pool.action_dims
     n = pool.n_agents
     torch.manual_seed(cfg.train.seed)

@@ -13,7 +13,8 @@ import time
 import numpy as np
 
 from confront.arena.tank import TankSpace
-from confront.learning.ppo import PPO, PPOConfig, Rollout
+from confront.learning.ppo import PPO, Rollout
+from confront.learning.ppo_config import PPOConfig
 
 SETTINGS = ((128, 4, 4, "fp32"), (128, 4, 4, "bf16"), (128, 2, 2, "fp32"), (128, 2, 2, "bf16"), (64, 2, 4, "fp32"),
             (128, 1, 2, "fp32"))

@@ -23,8 +23,9 @@ from pathlib import Path
 def arm(rounds: int, seed: int) -> list[dict]:
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["CONFRONT_CACHE"] = str(Path(tmp) / "cache")
-        from confront.experiments.spec import load_experiment
-        from confront.experiments.train import td_team, train_run
+        from confront.train.factory import train_run
+        from confront.train.league import td_team
+        from confront.train.spec import load_experiment
 
         cfg = load_experiment("awm", [f"train.rounds={rounds}", f"train.seed={seed}", "train.replay=false"])
         t0 = time.perf_counter()

@@ -10,8 +10,10 @@ import os
 
 import numpy as np
 
-from confront.experiments.spec import load_experiment
-from confront.experiments.tanks import build_pool, share_by_opponent, strafe_policy, tank_space
+from confront.train.league import build_pool, strafe_policy
+from confront.train.loop import share_by_opponent
+from confront.train.ppo_model import tank_space
+from confront.train.spec import load_experiment
 
 OPPONENTS = ["1v1:SpinBot", "1v1:Walls", "1v1:dodge", "4v4:dodge", "4v4:td", "1v1:strafe"]
 POLICIES = {"uniformly random tank actions": None, "strafe, circular lead, power 1": ("circular", 1.0),

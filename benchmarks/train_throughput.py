@@ -9,8 +9,8 @@ import json
 import os
 import time
 
-from confront.experiments.spec import load_experiment
-from confront.experiments.tanks import TankTrainer
+from confront.train.ppo_sim import TankTrainer
+from confront.train.spec import load_experiment
 
 
 def measure(opponents: list[str] | None, battles: int, updates: int, config: str = "tanks", overlap: bool = True,

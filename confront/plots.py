@@ -11,8 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from confront.experiments.stats import bootstrap_ci  # noqa: E402
 from confront.files import save_figure  # noqa: E402
+from confront.stats import bootstrap_ci  # noqa: E402
 
 COLORS = ("tab:red", "tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:brown", "tab:gray")
 

@@ -134,8 +134,9 @@ def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, co
 def train(config: str, out: Path | None, resume: Path | None, seed: int | None, engine: str, init: Path | None,
           quiet: bool, overrides: tuple[str, ...]) -> None:
     """Train one arm of an experiment; --resume RUN continues a killed run from its latest checkpoint."""
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import print_summary, train_run
+    from confront.train.factory import train_run
+    from confront.train.loop import print_summary
+    from confront.train.spec import load_experiment
 
     if resume is not None:  # a resumed run continues with its own config.toml and folder
         given = [name for name, value in (("--set", overrides), ("--out", out), ("--seed", seed), ("--init", init))
@@ -366,7 +367,7 @@ def config() -> None:
 @config.command("list")
 def config_list() -> None:
     """List the packaged experiment configs."""
-    from confront.experiments.spec import list_experiments
+    from confront.train.spec import list_experiments
 
     for name in list_experiments():
         click.echo(name)
@@ -378,7 +379,7 @@ def config_list() -> None:
 def config_show(experiment: str, overrides: tuple[str, ...]) -> None:
     """Print the fully resolved config of EXPERIMENT (a name or a TOML file) as TOML."""
     from confront.config import to_dict, to_toml
-    from confront.experiments.spec import load_experiment
+    from confront.train.spec import load_experiment
 
     click.echo(to_toml(to_dict(load_experiment(experiment, overrides))), nl=False)
 

@@ -5,7 +5,7 @@ Methods, all playing the paper's 4v4 scenario as team 0:
 - ``DQN (SB3)`` and ``PPO (SB3)``: one Stable-Baselines3 model shared by the 4 tanks (parameter sharing):
   :class:`SharedTeamVecEnv` has one sub-environment per (battle, our tank) over a
   :class:`~confront.arena.smdp.TeamBattleEnv`; needs the extra ``confront[baselines]``;
-- ``DMNN (FLM)``: the paper's method, trained by :func:`~confront.experiments.train.train_run`;
+- ``DMNN (FLM)``: the paper's method, trained by :func:`~confront.train.factory.train_run`;
 - the scripted sample robots SpinBot, Walls, Tracker and RamFire as our team (no training);
 - references that tell whether training helps: ``Random moves`` (``UniformPolicy``: each tank picks one of the
   four moves uniformly at random every SMDP step, same gun/radar controller) and ``DMNN (untrained)`` (the
@@ -38,9 +38,9 @@ import numpy as np
 
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.experiments.jobs import Claim, Job, Outcome, run_jobs, slug
-from confront.experiments.stats import Interval, interval
 from confront.learning.base import Learner, Transition
 from confront.learning.uniform import UniformParams, UniformPolicy
+from confront.stats import Interval, interval
 
 try:  # the optional extra confront[baselines]
     from stable_baselines3.common.vec_env.base_vec_env import VecEnv as _VecEnvBase
@@ -303,7 +303,7 @@ def sb3_exported_policy(state: Mapping[str, np.ndarray], activation: str, observ
 
 def baseline_experiment(cfg: BaselinesConfig, seed: int, rounds: int) -> Any:
     """The baselines' experiment (the paper's 4v4 against the TD team) at ``seed`` for ``rounds`` rounds."""
-    from confront.experiments.spec import load_experiment
+    from confront.train.spec import load_experiment
 
     return load_experiment(cfg.base, cfg.overrides + (f"train.seed={seed}", f"train.rounds={rounds}",
                                                       f"train.session_rounds={max(1, min(10, rounds // 2))}"))
@@ -321,8 +321,8 @@ def pooled_ratio(rows: Sequence[dict[str, Any]], flip: bool = False) -> tuple[fl
 def _evaluate(cfg: BaselinesConfig, exp: Any, seed: int, td_path: Path, policy: Learner | None = None,
               scripted: str = "") -> list[dict[str, Any]]:
     """Score rows of one method (a policy, or a scripted robot as our team) against every opponent."""
-    from confront.experiments.episodes import load_model
     from confront.experiments.evaluate import sim_bot_battle, sim_evaluate
+    from confront.train.paper_model import load_model
 
     if (policy is None) == (not scripted):
         raise ValueError("evaluate either a policy or a scripted robot")
@@ -351,7 +351,8 @@ def train_sb3(algo: str, cfg: BaselinesConfig, seed: int, rounds: int) -> tuple[
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.logger import Logger
 
-    from confront.experiments.episodes import scenario_of, smdp_config, td_team
+    from confront.train.league import td_team
+    from confront.train.paper_model import scenario_of, smdp_config
 
     if algo not in SB3_METHODS:
         raise ValueError(f"algo must be one of {', '.join(SB3_METHODS)}, got {algo!r}")
@@ -391,7 +392,8 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
     """Train (if needed) and evaluate one method at one seed; cached in ``folder/result.json``."""
 
     from confront import checkpoint as ck
-    from confront.experiments.episodes import load_model, td_team
+    from confront.train.league import td_team
+    from confront.train.paper_model import load_model
 
     done = folder / "result.json"
     if done.exists():
@@ -415,7 +417,7 @@ def _method_job(method: str, cfg: BaselinesConfig, seed: int, rounds: int, folde
         td_path = Path(summary["td_model"])
         extra.update(train_rounds=int(summary["rounds"]), train_seconds=float(summary["wall_time_s"]))
     else:
-        from confront.experiments.episodes import build_learner, smdp_config
+        from confront.train.paper_model import build_learner, smdp_config
 
         smdp = smdp_config(exp)
         _, td_path = td_team(exp, smdp.n_actions)
@@ -466,7 +468,7 @@ def plot_ranking(stats: dict[str, dict[str, Interval]], opponents: Sequence[str]
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from confront.experiments.plots import COLORS
+    from confront.plots import COLORS
 
     methods = sorted(stats, key=lambda m: -stats[m][opponents[0]].mean if opponents[0] in stats[m] else 1.0)
     x = np.arange(len(methods))

@@ -8,15 +8,16 @@ from pathlib import Path
 
 import click
 
-from confront.experiments.spec import load_experiment
 from confront.runs import new_run_name
+from confront.train.spec import load_experiment
 
 
 def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | None = None,
              overrides: tuple[str, ...] = (), paper: bool = False, contrast: bool = False) -> dict:
     """Train the demo config, print the score table, write plots; return the summary (with ``contrast``, also
     the paper's arm into ``<out>/paper-arm`` and ``plots/contrast.png``)."""
-    from confront.experiments.train import print_summary, train_run
+    from confront.train.factory import train_run
+    from confront.train.loop import print_summary
 
     extra = list(overrides)
     if rounds is not None:
@@ -65,8 +66,8 @@ def plot_contrast(tanks_run: Path, paper_run: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from confront.experiments.tanks import share_windows
     from confront.runs import Run
+    from confront.train.loop import share_windows
 
     ours = [r for r in Run(tanks_run).read_table("rounds") if r["opponent"] == "4v4:td"]
     theirs = Run(paper_run).read_table("rounds")

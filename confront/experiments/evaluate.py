@@ -14,10 +14,11 @@ import numpy as np
 from confront.arena.scenarios import Scenario
 from confront.arena.smdp import TeamBattleEnv
 from confront.config import load_toml
-from confront.experiments.episodes import Loop, Side, load_model, scenario_of, smdp_config
-from confront.experiments.spec import ExperimentConfig, config_from_dict
 from confront.learning.base import Learner
 from confront.results import BattleResults, ScoreRow
+from confront.train.episodes import Loop, Side
+from confront.train.paper_model import load_model, scenario_of, smdp_config
+from confront.train.spec import ExperimentConfig, config_from_dict
 
 if TYPE_CHECKING:
     from confront.engine.tank_export import Play
@@ -118,11 +119,11 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     from confront.engine.tank_export import is_tank_run
 
     if is_tank_run(run):  # PPO tanks: per league entry (the engine: the exported TankBot)
-        from confront.experiments.tanks import evaluate_tank_cli
+        from confront.experiments.tank_evaluate import evaluate_tank_cli
 
         evaluate_tank_cli(run, opponents, rounds, seed, play=play or "sampled")
         if engine == "robocode":
-            from confront.experiments.tanks import evaluate_tank_engine_cli
+            from confront.experiments.tank_evaluate import evaluate_tank_engine_cli
 
             evaluate_tank_engine_cli(run, opponents, rounds, seed, play=play or "sampled", visible=watch)
         return

@@ -76,8 +76,8 @@ class Outcome:
 
 
 def _run_job(job: Job, rounds: int | None, engine: str = "sim") -> str:
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import train_run
+    from confront.train.factory import train_run
+    from confront.train.spec import load_experiment
 
     if (job.folder / "summary.json").exists():
         return "cached"

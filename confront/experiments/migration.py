@@ -25,10 +25,10 @@ import gymnasium
 import numpy as np
 from numba import njit
 
-from confront.experiments.stats import median_ci, sign_test
 from confront.learning.base import check_int, check_range
 from confront.learning.factory import make_learner
 from confront.learning.tabular import TabularParams
+from confront.stats import median_ci, sign_test
 
 __all__ = [
     "METHODS",

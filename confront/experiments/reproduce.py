@@ -23,9 +23,9 @@ import numpy as np
 from scipy import stats
 
 from confront.experiments.jobs import Claim, Job, Outcome, run_jobs, slug
-from confront.experiments.plots import plot_curves
-from confront.experiments.stats import interval, mde_t, paired_comparison, paired_permutation_test
+from confront.plots import plot_curves
 from confront.runs import Run
+from confront.stats import interval, mde_t, paired_comparison, paired_permutation_test
 
 EXPERIMENTS = ("migration", "awm", "fuzzy", "transfer", "baselines")
 MIGRATION_SEEDS = 1000  # the tabular task runs all seeds side by side in seconds

@@ -28,7 +28,7 @@ import click
 import numpy as np
 
 from confront.config import ConfigError, load_toml, to_toml
-from confront.experiments.stats import bootstrap_ci
+from confront.stats import bootstrap_ci
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ def _value_text(v: Any) -> str:
 
 def read_grid(path: str | Path, seeds: int | None = None) -> tuple[str, list[Trial]]:
     """Parse a grid file into the base experiment and its trials (validated before anything runs)."""
-    from confront.experiments.spec import load_experiment
+    from confront.train.spec import load_experiment
 
     data = load_toml(path)
     unknown = set(data) - {"experiment", "seeds", "set", "grid"}
@@ -79,8 +79,8 @@ def read_grid(path: str | Path, seeds: int | None = None) -> tuple[str, list[Tri
 
 def run_trial(base: str, trial: Trial, out: Path) -> dict:
     """Train (or resume) one trial into ``out``; return its summary."""
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import train_run
+    from confront.train.factory import train_run
+    from confront.train.spec import load_experiment
 
     folder = out / "trials" / trial.name
     if (folder / "summary.json").exists():

@@ -61,11 +61,13 @@ from confront.experiments.baselines import (
 )
 from confront.experiments.evaluate import exported_policy, sim_evaluate
 from confront.experiments.jobs import Job, run_jobs
-from confront.experiments.spec import ExperimentConfig, config_from_dict, load_toml
-from confront.experiments.stats import paired_comparison
-from confront.experiments.tanks import evaluate_tanks, load_tank_model, paper_move_robot, paper_move_values
+from confront.experiments.tank_evaluate import evaluate_tanks
 from confront.learning.base import Learner
 from confront.learning.tabular import TabularQ
+from confront.stats import paired_comparison
+from confront.train.league import paper_move_robot, paper_move_values
+from confront.train.ppo_model import load_tank_model
+from confront.train.spec import ExperimentConfig, config_from_dict, load_toml
 
 __all__ = ["OURS", "METHODS", "compare_entries", "method_shares", "compare", "engine_policy",
            "engine_method_shares", "compare_engine", "write_markdown"]
@@ -98,8 +100,8 @@ def dodge_learner(exp: ExperimentConfig) -> TabularQ:
 def _baseline_policy(method: str, seed: int, work: Path, td_name: str) -> tuple[Learner, ExperimentConfig]:
     """The trained (or, for random moves, built) policy of ``method`` at ``seed``, and its experiment config
     (a trained DMNN is kept per TD-team artefact ``td_name``)."""
-    from confront.experiments.episodes import load_model, smdp_config
     from confront.learning.uniform import UniformParams, UniformPolicy
+    from confront.train.paper_model import load_model, smdp_config
 
     bcfg = BaselinesConfig()
     exp = baseline_experiment(bcfg, seed, TRAIN_ROUNDS)
@@ -157,7 +159,7 @@ def method_shares(method: str, seed: int, entries: list[str], td_model: str, rou
 def engine_paper_move_robot(exp: ExperimentConfig, opp: str) -> Any:
     """A paper-move opponent (``"random"``, ``"dodge"``) as the engine's PolicyBot at the baselines' step length
     and observation (:func:`tanks.paper_move_robot` with the baselines' experiment ``exp``)."""
-    from confront.experiments.episodes import smdp_config
+    from confront.train.paper_model import smdp_config
 
     return replace(paper_move_robot(exp, opp), observation=smdp_config(exp).observation,
                    step_turns=exp.arena.decision_turns)
@@ -168,7 +170,7 @@ def engine_policy(method: str, seed: int, work: Path, td_name: str) -> Any:
     by :func:`_baseline_policy` where it is not yet in ``work``: DMNN (FLM) greedy (``ExportedPolicy.from_learner``),
     SB3 PPO deterministic (:func:`sb3_exported_policy` of the kept ``policy.npz``), random moves as zero move
     values with random ties (:func:`engine_paper_move_robot`)."""
-    from confront.experiments.episodes import smdp_config
+    from confront.train.paper_model import smdp_config
 
     exp = baseline_experiment(BaselinesConfig(), seed, TRAIN_ROUNDS)
     observation, step_turns = smdp_config(exp).observation, exp.arena.decision_turns
@@ -195,7 +197,7 @@ def engine_method_shares(method: str, seed: int, entries: list[str], td_model: s
     observation: :func:`engine_paper_move_robot`). Each battle is
     kept in ``work/engine`` as it ends; one of other rounds, engine seed or TD-team artefact is played again."""
     from confront.engine.evaluate import evaluate_policy
-    from confront.experiments.episodes import load_model
+    from confront.train.paper_model import load_model
 
     path = work / "engine" / _result_file(method, seed)
     key: dict[str, Any] = {"method": method, "seed": seed, "rounds": rounds, "engine_seed": engine_seed,
@@ -237,7 +239,7 @@ def compare(runs: list[Path], out: Path, rounds: int, work: Path, ours: dict[str
     """Evaluate PPO tanks and every baseline method per seed and entry; write the report; return the results.
     ``ours``: PPO tanks' shares per entry (one per run, in order) when already measured (tank_report's);
     ``play``: how PPO tanks played them (``"greedy"`` or ``"sampled"``; the baselines play greedily)."""
-    from confront.experiments.episodes import td_team
+    from confront.train.league import td_team
 
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
     seeds = [c.train.seed for c in cfgs]
@@ -285,8 +287,8 @@ def compare_report(results: Path, out: Path, work: Path, base_seeds: list[int], 
     (``confront train -c tanks``'s). When every run names its training seed (``seedK``) the baselines are trained at
     those seeds and the comparison is paired over them (as ``--engine robocode``); otherwise at ``base_seeds``,
     unpaired: Welch's t."""
-    from confront.experiments.episodes import td_team
-    from confront.experiments.spec import load_experiment
+    from confront.train.league import td_team
+    from confront.train.spec import load_experiment
 
     rep = json.loads(results.read_text())
     if rep["rounds"] != rounds:
@@ -341,8 +343,8 @@ def compare_engine(results: Path, out: Path, rounds: int, work: Path, engine_see
     """PPO tanks' Robocode shares from a tank_report ``results.json`` (per engine run, training seed K: the mean
     of its battles) against every baseline at seed K in Robocode (:func:`engine_method_shares`), paired over
     seeds; writes ``compare-engine.json`` and ``compare-engine.md``."""
-    from confront.experiments.episodes import td_team
-    from confront.experiments.spec import load_experiment
+    from confront.train.league import td_team
+    from confront.train.spec import load_experiment
 
     rep = json.loads(results.read_text())
     runs = list(rep.get("engine_runs") or [])

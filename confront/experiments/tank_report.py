@@ -27,15 +27,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.experiments.spec import config_from_dict, load_toml
-from confront.experiments.tanks import (
-    PAPER_MOVE_OPPONENTS,
-    evaluate_tanks,
-    load_tank_model,
-    paper_move_robot,
-    share_windows,
-)
+from confront.experiments.tank_evaluate import evaluate_tanks
 from confront.runs import Run
+from confront.train.league import PAPER_MOVE_OPPONENTS, paper_move_robot
+from confront.train.loop import share_windows
+from confront.train.ppo_model import load_tank_model
+from confront.train.spec import config_from_dict, load_toml
 
 if TYPE_CHECKING:
     from confront.engine.tank_export import Play
@@ -107,7 +104,7 @@ def engine_share(run: Path, policy: Any, entry: str, rounds: int, seed: int, cfg
     ``<run>/eval/engine-<rounds>.json`` (``engine-sampled-<rounds>.json`` for a sampling robot) as soon as it
     is played (a long report that dies keeps its battles).
     A paper-move opponent (the TD team, the dodge, random moves) plays as the exported PolicyBot of the run's
-    config ``cfg`` (:func:`confront.experiments.tanks.paper_move_robot`)."""
+    config ``cfg`` (:func:`confront.train.league.paper_move_robot`)."""
     from confront.engine.tank_export import evaluate_tank_policy
 
     cache = run / "eval" / ("engine-" + ("sampled-" if policy.play == "sampled" else "") + f"{rounds}.json")

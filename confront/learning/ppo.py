@@ -38,63 +38,13 @@ import numpy as np
 import torch
 from torch import nn
 
+from confront.learning.ppo_config import PPOConfig
+
 IS_MAX = 2.0  # truncation of the behaviour -> proximal importance weight with ``overlap``
-PRECISIONS = ("fp32", "bf16", "bf16-hidden")  # ppo.precision: which layers multiply in bfloat16 (PPOConfig)
 UPDATE_STATS = ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_frac", "explained_variance")
 
-__all__ = ["UPDATE_STATS", "entropy_coef", "learning_rate", "PPOConfig", "ActorCritic", "PPO", "Rollout", "Tanh",
+__all__ = ["UPDATE_STATS", "entropy_coef", "learning_rate", "ActorCritic", "PPO", "Rollout", "Tanh",
            "team_mean", "greedy_joint"]
-
-
-@dataclass(frozen=True)
-class PPOConfig:
-    """PPO hyper-parameters (defaults: CleanRL's, with a larger batch for many agents)."""
-
-    hidden: int = 128
-    critic_hidden: int = 0  # the critic's width; 0: ``hidden`` (the critic is half of the update's FLOPs)
-    lr: float = 3e-4
-    rollout_steps: int = 32  # S
-    epochs: int = 4  # E
-    minibatches: int = 4  # M
-    gamma: float = 0.99  # per decision (T turns)
-    gae_lambda: float = 0.95
-    clip: float = 0.2
-    ent_coef: float = 0.01
-    ent_coef_end: float = 0.01  # the entropy coefficient after ent_anneal_updates (linear in between)
-    ent_anneal_updates: int = 0  # 0: ent_coef throughout
-    vf_coef: float = 0.5
-    max_grad_norm: float = 0.5
-    reward_scale: float = 0.01  # score points -> reward units
-    team_critic: bool = True
-    threads: int = 2  # torch threads of the update (acting uses one); with ``overlap`` of both (beside the env)
-    overlap: bool = False  # update on a second thread while the next rollout is collected (acting one update behind)
-    ema_decay: float = 0.0  # > 0: a Polyak average of the actor after each update, the policy the saved model plays
-    anneal_lr: bool = False  # the Adam step falls linearly from lr to 0 over the run (CleanRL's anneal_lr)
-    precision: str = "fp32"  # the update's layers: "fp32"; "bf16": every layer but the output one under bfloat16
-    # autocast (bfloat16 products, float32 sums, weights and output layers; 1.5x faster where the CPU has bfloat16
-    # instructions, but measured to train worse 1v1 play: docs/learning.md); "bf16-hidden": the hidden-to-hidden
-    # layer only (the features enter in float32)
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.ent_anneal_updates, int) or self.ent_anneal_updates < 0:
-            raise ValueError(f"ppo.ent_anneal_updates must be an integer >= 0, got {self.ent_anneal_updates!r}")
-        for name in ("hidden", "rollout_steps", "epochs", "minibatches", "threads"):
-            v = getattr(self, name)
-            if not isinstance(v, int) or v < 1:
-                raise ValueError(f"ppo.{name} must be an integer >= 1, got {v!r}")
-        if not isinstance(self.critic_hidden, int) or self.critic_hidden < 0:
-            raise ValueError(f"ppo.critic_hidden must be an integer >= 0, got {self.critic_hidden!r}")
-        if not 0 <= self.ema_decay < 1:
-            raise ValueError(f"ppo.ema_decay must be in [0, 1), got {self.ema_decay!r}")
-        for name, lo, hi in (("gamma", 0, 1), ("gae_lambda", 0, 1), ("clip", 0, 10)):
-            v = getattr(self, name)
-            if not lo <= v <= hi:
-                raise ValueError(f"ppo.{name} must be in [{lo}, {hi}], got {v!r}")
-        if self.precision not in PRECISIONS:
-            raise ValueError(f"ppo.precision must be one of {', '.join(PRECISIONS)}, got {self.precision!r}")
-        for name in ("lr", "reward_scale", "max_grad_norm"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"ppo.{name} must be > 0, got {getattr(self, name)!r}")
 
 
 def entropy_coef(c: PPOConfig, updates: int) -> float:
@@ -193,7 +143,7 @@ def _bf16_fast() -> bool:
 
 
 def _mlp(seq: nn.Sequential, x: torch.Tensor, precision: str) -> torch.Tensor:
-    """``seq(x)`` (Linear, Tanh, Linear, Tanh, Linear) at a ``precision`` of :data:`PRECISIONS`: the layers from
+    """``seq(x)`` (Linear, Tanh, Linear, Tanh, Linear) at a ``precision`` of ``PPOConfig.precision``: the layers from
     the first (``bf16``) or the second (``bf16-hidden``) up to the output one under bfloat16 autocast."""
     if precision == "fp32":
         return seq(x)

@@ -1,21 +1,19 @@
-"""The one training loop: any learner over any battle backend, into a run folder.
+"""The one training loop: any :class:`Trainer` advanced round by round, and a run folder around it.
 
-    config -> Trainer (learner x backend) -> advance() until train.rounds -> rows -> sessions, model, plots
+    Trainer.advance() until train.rounds (run_rounds) -> rows -> sessions, model, plots (run_trainer)
 
-A :class:`Trainer` plays and learns in steps and holds all it changes as data. Four implement it:
-:class:`~confront.experiments.episodes.SMDPTrainer` (the paper's learners in the simulator),
-:class:`~confront.experiments.tanks.TankTrainer` (PPO tanks in the simulator's league),
-:class:`~confront.experiments.train_engine.EngineTrainer` (the paper's learners live in Robocode, one battle
-per step) and :class:`~confront.experiments.tanks_engine.EngineTankTrainer` (PPO tanks in Robocode, one battle
-and one update per step). One loop advances them all, :func:`~confront.experiments.episodes.run_rounds` (also
-the TD team's pre-training); :func:`train_run` wraps it in a run folder, the same for all four: resume, progress bar,
+A :class:`Trainer` plays and learns in steps and holds all it changes as data. Four implement it, one per learner
+and backend (``confront.train.factory`` picks one): ``paper_sim.SMDPTrainer``, ``paper_engine.EngineTrainer``,
+``ppo_sim.TankTrainer`` and ``ppo_engine.EngineTankTrainer``. :func:`run_rounds` advances any of them (also the
+TD team's pre-training); :func:`run_trainer` wraps it in a run folder, the same for all four: resume, progress bar,
 TensorBoard scalars (``tb/``), checkpoints every ``train.checkpoint_every`` rounds, then the run's tables,
 summary and figures.
 
 Checkpoints hold everything that changes, so a simulator run killed at any time and resumed with ``--resume``
 ends with exactly the metrics of an uninterrupted run (an engine run loses at most the battle that was running).
 The run folder holds ``config.toml``, ``metrics/`` (rounds, sessions), ``model/``, ``plots/``, ``tb/``,
-``checkpoints/`` and ``summary.json``.
+``checkpoints/`` and ``summary.json``. Rows are one per round (``score_ours``, ``score_theirs``, ``won``, ...);
+here too what the summaries make of them: pooled shares, sessions, shares per opponent.
 """
 
 from __future__ import annotations
@@ -30,30 +28,12 @@ import click
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.config import ConfigError, load_toml, to_dict
-from confront.experiments.episodes import (  # the building blocks, re-exported (train.py was their home)
-    Loop,
-    Side,
-    SMDPTrainer,
-    build_learner,
-    load_model,
-    pooled_share,
-    record_round,
-    run_rounds,
-    save_model,
-    scenario_of,
-    smdp_config,
-    td_learner,
-    td_team,
-)
-from confront.experiments.spec import ExperimentConfig, config_from_dict
+from confront.config import load_toml, to_dict
 from confront.runs import Run
+from confront.train.spec import ExperimentConfig, config_from_dict
 
-__all__ = ["Trainer", "SMDPTrainer", "make_trainer", "train_run", "print_summary", "new_run", "resume_run",
-           "session_rows", "Loop", "Side", "build_learner", "load_model", "record_round", "run_rounds", "save_model",
-           "scenario_of", "smdp_config", "td_learner", "td_team"]
-
-ENGINES = ("sim", "robocode")
+__all__ = ["Trainer", "run_rounds", "run_trainer", "new_run", "resume_run", "pooled_share", "session_rows",
+           "share_by_opponent", "share_windows", "print_summary"]
 
 
 class Trainer(Protocol):
@@ -63,6 +43,13 @@ class Trainer(Protocol):
     desc: str  # progress-bar label
     bar_scalars: dict[str, str]  # scalar name -> progress-bar label
     final_window: int  # rounds the summary's final score ratio pools
+
+    @classmethod
+    def from_config(cls, cfg: ExperimentConfig, run: Run, progress: bool = False,
+                    cpu_constant_ms: float | None = None) -> Trainer:
+        """The trainer of ``cfg`` writing into ``run`` (``factory.make_trainer``); ``cpu_constant_ms``: the
+        engine's CPU constant (the engine trainers' default if None)."""
+        ...
 
     @property
     def rows(self) -> list[dict[str, Any]]:
@@ -91,32 +78,14 @@ class Trainer(Protocol):
     def close(self) -> None: ...
 
 
-def make_trainer(cfg: ExperimentConfig, run: Run, engine: str = "sim", progress: bool = False,
-                 cpu_constant_ms: float | None = None) -> Trainer:
-    """The trainer of ``cfg``'s learner on ``engine`` (imports the backend it needs only)."""
-    if engine not in ENGINES:
-        raise ConfigError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if cfg.train.init and cfg.learner.kind != "ppo":
-        raise ConfigError("train.init starts a PPO learner from a run's model; for the paper's learners use "
-                          "transfer.source")
-    if cfg.learner.kind == "ppo":
-        if engine == "robocode":
-            from confront.experiments.tanks_engine import EngineTankTrainer
+# -- rows --------------------------------------------------------------------------------------------------------
 
-            return EngineTankTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
-        if cfg.train.init:
-            raise ConfigError("train.init (a PPO run to start from) is used in the engine only (--engine robocode)")
-        from confront.experiments.tanks import TankTrainer
+def pooled_share(rows: list[dict[str, Any]]) -> float:
+    """Our score over both sides' (pooled over ``rows``; 0.5 when nobody scored)."""
+    o = sum(r["score_ours"] for r in rows)
+    t = sum(r["score_theirs"] for r in rows)
+    return o / (o + t) if o + t > 0 else 0.5
 
-        return TankTrainer(cfg, progress=progress)
-    if engine == "robocode":
-        from confront.experiments.train_engine import EngineTrainer
-
-        return EngineTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
-    return SMDPTrainer.from_config(cfg, progress=progress)
-
-
-# -- run folders -------------------------------------------------------------------------------------------------
 
 def session_rows(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
     """Aggregate round rows into sessions of ``size`` rounds (paper: 10); the score ratio pools the sums. Score
@@ -138,6 +107,61 @@ def session_rows(rows: list[dict[str, Any]], size: int) -> list[dict[str, Any]]:
         })
     return out
 
+
+def share_by_opponent(rows: list[dict[str, Any]]) -> dict[str, float]:
+    """Pooled score share per opponent over ``rows``."""
+    out: dict[str, list[float]] = {}
+    for r in rows:
+        o = out.setdefault(r["opponent"], [0.0, 0.0])
+        o[0] += r["score_ours"]
+        o[1] += r["score_theirs"]
+    return {k: v[0] / (v[0] + v[1]) if v[0] + v[1] > 0 else 0.5 for k, v in out.items()}
+
+
+def share_windows(rows: list[dict[str, Any]], size: int) -> list[tuple[int, float]]:
+    """(rounds so far, pooled score share) per consecutive window of ``size`` rounds (a partial last one dropped;
+    rows read back from a run's CSV tables too)."""
+    out = []
+    for end in range(size, len(rows) + 1, size):
+        chunk = rows[end - size:end]
+        o = sum(float(r["score_ours"]) for r in chunk)
+        t = sum(float(r["score_theirs"]) for r in chunk)
+        out.append((end, o / (o + t) if o + t > 0 else 0.5))
+    return out
+
+
+# -- the loop ----------------------------------------------------------------------------------------------------
+
+def run_rounds(trainer: Any, rounds: int, progress: bool, desc: str | None = None, on_step: Any = None,
+               window: int = 10) -> None:
+    """The one training loop: ``trainer.advance`` until ``rounds`` rounds are done (any :class:`Trainer`), with a
+    progress bar (the share of the last ``window`` rounds and the trainer's ``bar_scalars``); ``on_step(scalars)``
+    after every step in which rounds ended."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=rounds, initial=min(trainer.rounds_done, rounds), desc=desc or trainer.desc, unit="round",
+               disable=not progress, dynamic_ncols=True)
+
+    def tick(done: int) -> None:
+        bar.update(min(done, rounds) - bar.n)
+
+    try:
+        while trainer.rounds_done < rounds:
+            before = trainer.rounds_done
+            scalars = trainer.advance(rounds, tick)
+            if trainer.rounds_done == before:
+                continue
+            tick(trainer.rounds_done)
+            bar.set_postfix(share=f"{pooled_share(trainer.rows[-window:]):.3f}", refresh=False,
+                            **{label: f"{scalars[k]:,.0f}" if abs(scalars[k]) >= 100 else f"{scalars[k]:.3f}"
+                               for k, label in trainer.bar_scalars.items() if k in scalars})
+            if on_step is not None:
+                on_step(scalars)
+    finally:
+        bar.close()
+
+
+# -- run folders -------------------------------------------------------------------------------------------------
 
 def resume_run(out: str | Path | None) -> tuple[Run, ExperimentConfig]:
     """An existing run folder and the config it was started with (for ``--resume``)."""
@@ -169,30 +193,11 @@ def _log(writer: Any, trainer: Trainer, scalars: dict[str, float], window: int) 
             writer.add_scalar(f"train/{k}", v, step)
 
 
-def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool = False, progress: bool = True,
-              exist_ok: bool = False, engine: str = "sim", cpu_constant_ms: float | None = None) -> dict[str, Any]:
-    """Train ``cfg``'s learner on ``engine`` ("sim" or "robocode") into a run folder, or continue the run in
-    ``out`` with ``resume`` (its own config); return the summary."""
-    t_setup = time.time()
-    if resume:
-        run, cfg = resume_run(out)
-    elif cfg is None:
-        raise ValueError("train_run needs a config unless resuming")
-    else:
-        run = new_run(cfg, out, exist_ok)
-    try:
-        trainer = make_trainer(cfg, run, engine, progress=progress, cpu_constant_ms=cpu_constant_ms)
-    except Exception:
-        run.discard_if_new()  # a failed start leaves no half-made run folder
-        raise
-    try:
-        return _train(cfg, run, trainer, resume, progress, setup_s=time.time() - t_setup)
-    finally:
-        trainer.close()
-
-
-def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, progress: bool,
-           setup_s: float) -> dict[str, Any]:
+def run_trainer(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, progress: bool,
+                setup_s: float) -> dict[str, Any]:
+    """Train ``trainer`` to ``train.rounds`` rounds in ``run`` (from its latest checkpoint with ``resume``):
+    checkpoints, TensorBoard scalars, the rounds and sessions tables, the trainer's own outputs and the summary,
+    which it returns."""
     from torch.utils.tensorboard import SummaryWriter
 
     elapsed_before = 0.0
@@ -246,12 +251,12 @@ def _train(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool, prog
     return summary
 
 
+# -- the terminal ------------------------------------------------------------------------------------------------
+
 def print_summary(summary: dict[str, Any]) -> None:
     """The results table of a run, for the terminal."""
     if summary.get("learner") == "ppo":
-        from confront.experiments.tanks import print_tank_summary
-
-        return print_tank_summary(summary)
+        return _print_ppo_summary(summary)
     run = Run(Path(summary["run"]))
     sessions = run.read_table("sessions")
     where = " in Robocode" if summary.get("engine") == "robocode" else ""
@@ -260,10 +265,35 @@ def print_summary(summary: dict[str, Any]) -> None:
     if sessions:
         click.echo("\n| session | score ours | score theirs | score ratio | defensive ours | win rate |")
         click.echo("|---:|---:|---:|---:|---:|---:|")
-        step = max(1, len(sessions) // 10)
-        for s in sessions[::step] + ([sessions[-1]] if (len(sessions) - 1) % step else []):
+        for s in _some(sessions):
             click.echo(f"| {s['session']} | {s['score_ours']:.0f} | {s['score_theirs']:.0f} | "
                        f"{s['score_ratio']:.3f} | {s.get('defensive_ours', math.nan):.0f} | {s['win_rate']:.2f} |")
     click.echo(f"\nscore ratio over the last {summary['final_window_rounds']} rounds: "
                f"{summary['final_score_ratio']:.3f} (win rate {summary['win_rate_last']:.2f})")
     click.echo(f"run folder: {summary['run']}  (plots/, metrics/, model/, tb/, summary.json)")
+
+
+def _print_ppo_summary(summary: dict[str, Any]) -> None:
+    """The results table of a PPO run: sessions, then the share per opponent."""
+    run = Run(Path(summary["run"]))
+    sessions = run.read_table("sessions")
+    click.echo(f"\n{summary['name']}: {summary['rounds']} rounds against the league in {summary['wall_time_s']:.1f} s "
+               f"({summary['decisions']:,} decisions, {summary['decisions_per_s']:,.0f}/s)")
+    if sessions:
+        click.echo("\n| session | decisions | score ours | score theirs | score share | win rate |")
+        click.echo("|---:|---:|---:|---:|---:|---:|")
+        for s in _some(sessions):
+            click.echo(f"| {s['session']} | {int(float(s['decisions'])):,} | {float(s['score_ours']):.0f} | "
+                       f"{float(s['score_theirs']):.0f} | {float(s['score_ratio']):.3f} | {float(s['win_rate']):.2f} |")
+    click.echo(f"\nscore share over the last {summary['final_window_rounds']} rounds, per opponent:")
+    for name, v in sorted(summary["share_by_opponent_last"].items()):
+        click.echo(f"  {name:<18} {v:.3f}")
+    click.echo(f"all: {summary['final_score_ratio']:.3f} (first session {summary['first_session_ratio']:.3f}, "
+               f"last {summary['last_session_ratio']:.3f})")
+    click.echo(f"run folder: {summary['run']}  (plots/, metrics/, model/, tb/, summary.json)")
+
+
+def _some(sessions: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """About ten sessions, evenly spaced, and the last."""
+    step = max(1, len(sessions) // 10)
+    return sessions[::step] + ([sessions[-1]] if (len(sessions) - 1) % step else [])

@@ -1,5 +1,5 @@
 """Training a config's learner live in the real engine (``confront train --engine robocode``): the
-:class:`EngineTrainer` of the one training loop (``train.train_run``), one battle per step.
+:class:`EngineTrainer` of the one training loop (``loop.run_trainer``), one battle per step.
 
 Our side is a team of BridgeBots sharing one learner through the bridge (parameter sharing; ``LearnerPolicy``:
 a round trip only every ``arena.decision_turns`` turns, the gun/radar controller in Java, the Eq. 35 rewards from
@@ -30,7 +30,6 @@ import numpy as np
 
 from confront import checkpoint as ck
 from confront.arena.observe import ObservationConfig
-from confront.arena.state import SCORE_PARTS
 from confront.checkpoint import CheckpointError
 from confront.config import ConfigError
 from confront.engine.battle import SCENARIO_SIZES, BattleSpec, robot_class, scenario_battle, single_star
@@ -40,62 +39,16 @@ from confront.engine.export import ExportedPolicy, export_robot
 from confront.engine.install import find_engine
 from confront.engine.learner_policy import LearnerPolicy
 from confront.engine.runner import EngineOptions
-from confront.experiments.episodes import build_learner, save_model, td_team, with_transfer
-from confront.experiments.spec import ExperimentConfig
 from confront.runs import Run
+from confront.train.engine_logs import round_rows
+from confront.train.league import td_team
+from confront.train.paper_model import build_learner, save_model, with_transfer
+from confront.train.spec import ExperimentConfig
 
-__all__ = ["EngineTrainer", "round_rows", "ENGINE_PARTS", "POLICY_BOT"]
+__all__ = ["EngineTrainer", "POLICY_BOT"]
 
-# simulator score part -> the engine's score snapshot key [Robocode RobotStatistics; ram_dmg already x2]
-ENGINE_PARTS: dict[str, str] = {
-    "survival": "survival", "last_survivor": "surv_bonus", "bullet_damage": "bullet_dmg",
-    "bullet_kill_bonus": "bullet_bonus", "ram_damage": "ram_dmg", "ram_kill_bonus": "ram_bonus",
-}
 POLICY_BOT = "confront.PolicyBot*"
 N_MOVES = 4  # the paper's four macro moves; the engine's robots know no fire-power actions
-
-
-def round_rows(round_scores: list[dict[str, Any]], ours: int = 0) -> list[dict[str, Any]]:
-    """Rows of ``metrics/rounds.csv`` (the simulator's columns) from the runner's per-round scores.
-
-    Each entry holds every robot's battle totals at the end of a round; a round's parts are the differences
-    to the previous round's totals, so they add up to the engine's results. ``ours`` is our contestant index;
-    every other contestant is theirs. A round is decided when at most one contestant has a robot alive.
-    """
-    rows: list[dict[str, Any]] = []
-    before: list[dict[str, float]] | None = None
-    for i, rnd in enumerate(round_scores):
-        robots = rnd["robots"]
-        if before is not None and len(before) != len(robots):
-            raise ValueError(f"round {rnd.get('round')} has {len(robots)} robots, the round before {len(before)}")
-        prev = before or [{k: 0.0 for k in ENGINE_PARTS.values()} for _ in robots]
-        # this round's part = battle total now - battle total after the previous round
-        delta = [{k: float(r["score"][k]) - p[k] for k in ENGINE_PARTS.values()}
-                 for r, p in zip(robots, prev, strict=True)]
-        before = [{k: float(r["score"][k]) for k in ENGINE_PARTS.values()} for r in robots]
-        mine = [j for j, r in enumerate(robots) if r["contestant"] == ours]
-        other = [j for j, r in enumerate(robots) if r["contestant"] != ours]
-        if not mine or not other:
-            raise ValueError(f"round {rnd.get('round')} has no robots of contestant {ours} or no opponents")
-        alive_o = sum(bool(robots[j]["alive"]) for j in mine)
-        alive_t = sum(bool(robots[j]["alive"]) for j in other)
-        decided = len({r["contestant"] for r in robots if r["alive"]}) <= 1
-        parts_o = {p: sum(delta[j][k] for j in mine) for p, k in ENGINE_PARTS.items()}
-        parts_t = {p: sum(delta[j][k] for j in other) for p, k in ENGINE_PARTS.items()}
-        total_o, total_t = sum(parts_o.values()), sum(parts_t.values())
-        row: dict[str, Any] = {"battle": 0, "turns": int(rnd["turns"]), "decided": decided,
-                               "score_ours": total_o, "score_theirs": total_t,
-                               "score_ratio": total_o / (total_o + total_t) if total_o + total_t > 0 else 0.5,
-                               # defensive score: survival + last-survivor bonus, as the simulator's rows
-                               "defensive_ours": parts_o["survival"] + parts_o["last_survivor"],
-                               "defensive_theirs": parts_t["survival"] + parts_t["last_survivor"],
-                               "won": decided and alive_o > 0, "alive_ours": alive_o, "alive_theirs": alive_t}
-        for p in SCORE_PARTS:
-            row[f"{p}_ours"] = parts_o[p]
-            row[f"{p}_theirs"] = parts_t[p]
-        row["round"] = i + 1
-        rows.append(row)
-    return rows
 
 
 def _opponent(cfg: ExperimentConfig, obs_cfg: ObservationConfig, robots: Path,
@@ -181,6 +134,12 @@ class EngineTrainer:
         self.info.update(opp_info)
         self.desc = f"{cfg.name} {cfg.arena.scenario} (robocode)"
 
+    @classmethod
+    def from_config(cls, cfg: ExperimentConfig, run: Run, progress: bool = False,
+                    cpu_constant_ms: float | None = None) -> EngineTrainer:
+        """``cfg``'s trainer (``factory.make_trainer``)."""
+        return EngineTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
+
     @property
     def rounds_done(self) -> int:
         return len(self.rows)
@@ -247,7 +206,7 @@ class EngineTrainer:
         """The model and figures; the summary keys (train_run's plus the engine's skipped turns, bridge
         failures and errors, round trips, the engine's own setup time, and the SMDP steps closed without the
         robot's end line)."""
-        from confront.experiments.plots import session_plots
+        from confront.plots import session_plots
 
         cfg = self.cfg
         save_model(run.path / "model", self.learner,

@@ -1,5 +1,5 @@
 """PPO tanks trained in the real engine (``confront train -c <ppo config> --engine robocode``): the
-:class:`EngineTankTrainer` of the one training loop (``train.train_run``), one battle per step, one PPO update
+:class:`EngineTankTrainer` of the one training loop (``loop.run_trainer``), one battle per step, one PPO update
 per battle (on-policy: the battle is the rollout).
 
     PPO actor -> TankPolicy (play sampled) -> policy file -> one engine battle of train.checkpoint_every rounds
@@ -26,7 +26,7 @@ the robots' current-round scores (as the simulator's), which in team battles gro
 bullets in flight; the rows (``round_rows``: the engine's totals, closed at each robot's death) do not count them.
 
 Run folder: the simulator's (config.toml, metrics/rounds.csv with EngineTrainer's columns plus ``opponent``,
-``decisions`` and ``wall_s``, metrics/sessions.csv, metrics/updates.csv, model/ as ``save_tank_model`` writes
+``decisions`` and ``wall_s``, metrics/sessions.csv, metrics/updates.csv, model/ as ``ppo_model.save_tank_model`` writes
 it, plots/, summary.json) and engine/battle-NNN/results.txt and results.csv. Checkpoints after every battle
 (the PPO's state, rows, counters; data only), so ``--resume`` continues after a kill at the next battle.
 """
@@ -37,7 +37,7 @@ import math
 import tempfile
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -53,107 +53,17 @@ from confront.engine.export import export_robot
 from confront.engine.install import find_engine
 from confront.engine.runner import EngineOptions, EngineRun, run_battle
 from confront.engine.tank_export import TANK_CPU_CONSTANT_MS, TANK_ROBOT, TankPolicy, export_tank_robot
-from confront.experiments.spec import SCRIPTED_BOTS, ExperimentConfig
-from confront.experiments.tanks import (
-    PAPER_MOVE_OPPONENTS,
-    load_tank_model,
-    paper_move_robot,
-    ppo_config,
-    save_tank_model,
-    share_by_opponent,
-    tank_space,
-)
-from confront.experiments.train_engine import round_rows
 from confront.learning.ppo import PPO, UPDATE_STATS, Rollout
 from confront.runs import Run
+from confront.train.engine_logs import Decision, ScoreLog, read_decisions, read_scores, round_rows
+from confront.train.league import PAPER_MOVE_OPPONENTS, paper_move_robot
+from confront.train.loop import share_by_opponent
+from confront.train.ppo_model import load_tank_model, save_tank_model, tank_space
+from confront.train.spec import SCRIPTED_BOTS, ExperimentConfig
 
-__all__ = ["EngineTankTrainer", "Decision", "ScoreLog", "read_decisions", "read_scores", "episode_rewards",
-           "pack_episodes", "engine_entries", "TANK_CPU_CONSTANT_MS", "DECISION_SUFFIX"]
+__all__ = ["EngineTankTrainer", "episode_rewards", "pack_episodes", "engine_entries"]
 
-DECISION_SUFFIX = ".decisions"  # TankBot.LOG_SUFFIX
 POLICY_BOT = "confront.PolicyBot"
-
-
-# -- the logs ---------------------------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class Decision:
-    """One logged TankBot decision: robot name, round (0-based), turn (``getTime()``), joint action, the view
-    (float64, as Java computed it), the uniform draws, and with the log's detail what the view was made of:
-    (own values (13), enemy rows, mate rows) as TankCheck's "V" request."""
-
-    robot: str
-    round: int
-    turn: int
-    action: int
-    view: np.ndarray
-    draws: np.ndarray
-    detail: tuple[list[float], list[list[float]], list[list[float]]] | None = None
-
-
-def _nums(text: str) -> list[float]:
-    return [float(x) for x in text.split()]
-
-
-def _rows(text: str) -> list[list[float]]:
-    return [_nums(r) for r in text.split("|")] if text.strip() else []
-
-
-def read_decisions(folder: Path) -> list[Decision]:
-    """Every decision TankBot logged into ``folder`` (one file per robot), by robot, round and turn."""
-    out: list[Decision] = []
-    for path in sorted(Path(folder).glob(f"*{DECISION_SUFFIX}")):
-        for line in path.read_text(encoding="utf-8").splitlines():
-            p = line.split("\t")
-            if len(p) < 6:
-                raise ValueError(f"{path.name}: a decision line has {len(p)} fields, expected 6 or 9")
-            detail = (_nums(p[6]), _rows(p[7]), _rows(p[8])) if len(p) >= 9 else None
-            out.append(Decision(p[0], int(p[1]), int(p[2]), int(p[3]), np.array(_nums(p[4])),
-                                np.array(_nums(p[5])), detail))
-    out.sort(key=lambda d: (d.robot, d.round, d.turn))
-    return out
-
-
-@dataclass(frozen=True)
-class ScoreLog:
-    """One round of the runner's per-turn scores: the logged turns (K,) ascending, each robot's life (K, R) and
-    current-round score (K, R) from that turn on (a turn not logged is the one before it unchanged; before the
-    first line every score is 0 and every robot alive)."""
-
-    turns: np.ndarray
-    alive: np.ndarray
-    score: np.ndarray
-
-    def at(self, turn: int) -> int:
-        """The row in force after ``turn`` (-1: before the first line)."""
-        return int(np.searchsorted(self.turns, turn, side="right")) - 1
-
-    def margin(self, turn: int, ours: np.ndarray) -> float:
-        """Our robots' score (``ours`` (R,) bool) minus the others' after ``turn``."""
-        k = self.at(turn)
-        return 0.0 if k < 0 else float(self.score[k][ours].sum() - self.score[k][~ours].sum())
-
-    def decided(self, contestant: np.ndarray) -> int | None:
-        """The first turn at which at most one contestant (``contestant`` (R,) ints) has a robot alive."""
-        for k in range(len(self.turns)):
-            if len(set(contestant[self.alive[k]].tolist())) <= 1:
-                return int(self.turns[k])
-        return None
-
-
-def read_scores(path: Path, n_robots: int) -> dict[int, ScoreLog]:
-    """The runner's score log (``-Dconfront.scores``) per round."""
-    rounds: dict[int, tuple[list[int], list[list[bool]], list[list[float]]]] = {}
-    for line in Path(path).read_text(encoding="utf-8").splitlines():
-        p = line.split()
-        if len(p) != 3 + n_robots or len(p[2]) != n_robots:
-            raise ValueError(f"score log line {line[:80]!r} does not have {n_robots} robots")
-        t, a, s = rounds.setdefault(int(p[0]), ([], [], []))
-        t.append(int(p[1]))
-        a.append([c == "1" for c in p[2]])
-        s.append([float(x) for x in p[3:]])
-    return {r: ScoreLog(np.array(t, dtype=np.int64), np.array(a, dtype=bool).reshape(-1, n_robots),
-                        np.array(s, dtype=np.float64).reshape(-1, n_robots)) for r, (t, a, s) in rounds.items()}
 
 
 def episode_rewards(turns: Sequence[int], margin: Any, end: int, alive_at_end: bool, step_turns: int
@@ -231,7 +141,7 @@ class EngineTankTrainer:
         self.cfg, self.run = cfg, run
         self.cpu_constant_ms = TANK_CPU_CONSTANT_MS if cpu_constant_ms is None else cpu_constant_ms
         self.space = tank_space(cfg)
-        self.ppo = PPO(self.space.n_features, self.space.dims, ppo_config(cfg), seed=cfg.train.seed)
+        self.ppo = PPO(self.space.n_features, self.space.dims, cfg.ppo, seed=cfg.train.seed)
         self.info: dict[str, Any] = {}
         if cfg.train.init:
             self.ppo.load_state_dict(load_tank_model(cfg.train.init, cfg).state_dict())
@@ -253,6 +163,12 @@ class EngineTankTrainer:
         except Exception:
             self._tmp.cleanup()
             raise
+
+    @classmethod
+    def from_config(cls, cfg: ExperimentConfig, run: Run, progress: bool = False,
+                    cpu_constant_ms: float | None = None) -> EngineTankTrainer:
+        """``cfg``'s trainer (``factory.make_trainer``)."""
+        return EngineTankTrainer(cfg, run, progress=progress, cpu_constant_ms=cpu_constant_ms)
 
     @property
     def rounds_done(self) -> int:
@@ -406,7 +322,7 @@ class EngineTankTrainer:
     def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
         """The model (``save_tank_model``: ``confront evaluate`` / ``export`` work on the run),
         ``metrics/updates.csv``, the figures; the summary's PPO and engine keys."""
-        from confront.experiments.plots import session_plots
+        from confront.plots import session_plots
 
         cfg = self.cfg
         run.write_table("updates", self.updates)

@@ -14,8 +14,9 @@ from typing import Literal
 
 from confront.arena.scenarios import SAMPLE_TEAMS
 from confront.config import ConfigError, field, from_dict, load_toml, merge, parse_override, to_dict
+from confront.learning.ppo_config import PPOConfig
 
-CONFIG_PACKAGE = "confront.experiments.configs"
+CONFIG_PACKAGE = "confront.train.configs"
 # the sample robots of confront.arena.bots.BOT_NAMES that fight on their own, known without loading the simulator (a
 # test keeps them equal); the sample teams (a leader and droids) are SAMPLE_TEAMS
 SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire")
@@ -144,41 +145,6 @@ class TankSection:
 
 
 @dataclass
-class PPOSection:
-    """PPO hyper-parameters (confront.learning.ppo)."""
-
-    hidden: int = field(128, ge=1, le=4096)
-    critic_hidden: int = field(0, ge=0, le=4096, doc="the critic's width (0: hidden): 64 updates 1.29x faster but "
-                               "trained worse greedy 1v1 play on its one seed (docs/learning.md)")
-    lr: float = field(2.5e-3, gt=0.0, le=1.0, doc="Adam step (measured: 2.5e-3 learned ~2x faster than 1e-3)")
-    rollout_steps: int = field(32, ge=1, le=4096)
-    epochs: int = field(4, ge=1, le=100, doc="passes over each rollout (the demo uses 2 x 2: docs/learning.md)")
-    minibatches: int = field(4, ge=1, le=1024)
-    gamma: float = field(0.97, ge=0.0, le=1.0, doc="discount per decision (T turns): a horizon of ~33 decisions")
-    gae_lambda: float = field(0.95, ge=0.0, le=1.0)
-    clip: float = field(0.2, gt=0.0, le=10.0)
-    ent_coef: float = field(0.01, ge=0.0, le=10.0)
-    ent_coef_end: float = field(0.01, ge=0.0, le=10.0, doc="entropy coefficient after ent_anneal_updates")
-    ent_anneal_updates: int = field(0, ge=0, doc="updates over which ent_coef goes linearly to ent_coef_end (0: off)")
-    vf_coef: float = field(0.5, ge=0.0, le=100.0)
-    max_grad_norm: float = field(0.5, gt=0.0)
-    reward_scale: float = field(0.01, gt=0.0, doc="score points -> reward units")
-    team_critic: bool = field(True, doc="the critic also sees the mean view of the tank's team (MAPPO-style)")
-    overlap: bool = field(False, doc="update on a second thread while the next rollout is collected (acting one "
-                          "update behind, decoupled PPO); false: collect, then update (docs/learning.md)")
-    ema_decay: float = field(0.0, ge=0.0, lt=1.0, doc="> 0: a Polyak average of the actor after each update "
-                             "(decay per update), the policy the finished run saves and plays; 0: the last actor")
-    anneal_lr: bool = field(False, doc="the Adam step falls linearly from lr to 0 over train.rounds (CleanRL's "
-                            "anneal_lr)")
-    threads: int = field(2, ge=1, le=256, doc="torch threads of the update (acting uses one): 2 updates 1.7x faster "
-                         "than 1 on the idle 2-core machine; the float sums, hence the run's bits, depend on it")
-    precision: Literal["fp32", "bf16", "bf16-hidden"] = field(
-        "fp32", doc="the update's layers: fp32; bf16 (all but the output layer as bfloat16 products under autocast, "
-        "float32 sums and weights: a 1.5x faster update on CPUs with bfloat16 instructions, but worse 1v1 play where "
-        "measured); bf16-hidden (the hidden-to-hidden layer only); docs/learning.md")
-
-
-@dataclass
 class LeagueSection:
     """The PPO opponents: battles of each kind side by side, every rollout."""
 
@@ -253,7 +219,7 @@ class ExperimentConfig:
     transfer: TransferSection = field(default_factory=TransferSection)
     train: TrainSection = field(default_factory=TrainSection)
     tank: TankSection = field(default_factory=TankSection)
-    ppo: PPOSection = field(default_factory=PPOSection)
+    ppo: PPOConfig = field(default_factory=PPOConfig)
     league: LeagueSection = field(default_factory=LeagueSection)
 
     def __post_init__(self) -> None:

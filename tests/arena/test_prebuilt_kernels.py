@@ -75,17 +75,17 @@ def _last_line(script: str, env: dict[str, str]) -> object:
 
 SCRIPT = COMPILES + textwrap.dedent("""
     from confront.arena.smdp import TeamBattleEnv
-    from confront.experiments import tanks
-    from confront.experiments.episodes import smdp_config
-    from confront.experiments.spec import load_experiment
+    from confront.train import league
+    from confront.train.paper_model import smdp_config
+    from confront.train.spec import load_experiment
 
     cfg = load_experiment("tanks-demo", ())
     # the TD team's pre-training env, then the league with a stand-in for the trained TD team
     env = TeamBattleEnv("4v4", n_battles=2, seed=0, opponents=cfg.opponent.pretrain_against, config=smdp_config(cfg))
     env.reset()
     env.step(np.zeros((2, env.n_robots), dtype=np.int64))
-    tanks._td_opponent = lambda cfg, progress: tanks.random_policy
-    pool, _ = tanks.build_pool(cfg, 0, battles=2)
+    league.td_policy = lambda cfg, progress: league.random_policy
+    pool, _ = league.build_pool(cfg, 0, battles=2)
     pool.reset()
     for _ in range(2):
         pool.step(np.zeros(pool.n_agents, dtype=np.int64))

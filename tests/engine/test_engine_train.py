@@ -12,12 +12,14 @@ import pytest
 
 from confront import checkpoint as ck
 from confront.checkpoint import CheckpointError
-from confront.experiments import train_engine
-from confront.experiments.spec import load_experiment
-from confront.experiments.train import load_model, save_model, td_learner, train_run
-from confront.experiments.train_engine import ENGINE_PARTS, round_rows
 from confront.learning.tabular import TabularParams, TabularQ
 from confront.results import parse_results_text
+from confront.train import paper_engine
+from confront.train.engine_logs import ENGINE_PARTS, round_rows
+from confront.train.factory import train_run
+from confront.train.league import td_learner
+from confront.train.paper_model import load_model, save_model
+from confront.train.spec import load_experiment
 
 
 def _robot(contestant: int, alive: bool, **parts: float) -> dict[str, Any]:
@@ -81,7 +83,7 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path,
                                    "train.seed=3", "train.checkpoint_every=2"])
     out = tmp_path / "run"
     # the run is interrupted while its second battle starts: the first battle's checkpoint survives
-    real, calls = train_engine.run_bridged_battle, []
+    real, calls = paper_engine.run_bridged_battle, []
 
     def interrupted(*args: object, **kwargs: object) -> object:
         calls.append(1)
@@ -89,10 +91,10 @@ def test_learner_trains_in_engine_into_a_run_folder(install, tmp_path: Path,
             raise KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(train_engine, "run_bridged_battle", interrupted)
+    monkeypatch.setattr(paper_engine, "run_bridged_battle", interrupted)
     with pytest.raises(KeyboardInterrupt):
         train_run(cfg, out, progress=False, engine="robocode")
-    monkeypatch.setattr(train_engine, "run_bridged_battle", real)
+    monkeypatch.setattr(paper_engine, "run_bridged_battle", real)
     with open(out / "metrics" / "rounds.csv") as f:
         first = list(csv.DictReader(f))
     assert [int(r["round"]) for r in first] == [1, 2] and not (out / "summary.json").exists()

@@ -14,8 +14,9 @@ from confront.experiments.evaluate import (
     sim_evaluate,
     sim_ratios,
 )
-from confront.experiments.spec import load_experiment
-from confront.experiments.train import load_model, train_run
+from confront.train.factory import train_run
+from confront.train.paper_model import load_model
+from confront.train.spec import load_experiment
 
 
 def test_evaluate_table_has_the_simulator_ratio_and_its_seed_range(tmp_path: Path, capsys) -> None:

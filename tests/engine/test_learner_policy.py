@@ -170,8 +170,8 @@ def test_recorded_engine_stream_gives_the_table_of_the_code_before(mode: str) ->
     from pathlib import Path
 
     from confront.engine.bridge import parse_history, parse_observation
-    from confront.experiments.episodes import build_learner
-    from confront.experiments.spec import load_experiment
+    from confront.train.paper_model import build_learner
+    from confront.train.spec import load_experiment
 
     fixtures = Path(__file__).parents[1] / "fixtures" / "bridge"
     cfg = load_experiment("demo", ["arena.scenario=1v1", "opponent.kind=SpinBot", "learner.kind=ssaq"])

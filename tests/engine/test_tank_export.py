@@ -486,7 +486,8 @@ def test_exported_robot_plays_like_the_simulator_turn_by_turn(install, tmp_path,
 
 def test_twin_acts_like_the_ppo_learner(views) -> None:
     """The learner's actor arrays, as ``confront train`` saves them, give the learner's greedy actions."""
-    from confront.learning.ppo import PPO, PPOConfig
+    from confront.learning.ppo import PPO
+    from confront.learning.ppo_config import PPOConfig
 
     ppo = PPO(SPACE.n_features, SPACE.dims, PPOConfig(hidden=32), seed=3)
     rng = np.random.default_rng(5)
@@ -528,8 +529,8 @@ def test_tankbot_against_a_paper_move_team_in_the_engine(install) -> None:
     """A paper-move opponent (here the dodge) plays in the engine as four exported PolicyBots with random ties."""
     from confront.engine.export import ExportedPolicy
     from confront.engine.tank_export import evaluate_tank_policy
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.tanks import paper_move_robot
+    from confront.train.league import paper_move_robot
+    from confront.train.spec import load_experiment
 
     theirs = paper_move_robot(load_experiment("tanks-demo"), "dodge")
     assert isinstance(theirs, ExportedPolicy) and theirs.ties == "random" and theirs.step_turns == 5
@@ -546,8 +547,8 @@ def test_tankbot_share_is_its_own_against_a_policybot_1v1(install) -> None:
     """1v1 against an exported PolicyBot both names start with "confront.": the share returned is TankBot's, also
     when the PolicyBot ranks first (here TankBot holds still and never fires)."""
     from confront.engine.tank_export import TANK_ROBOT, evaluate_tank_policy
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.tanks import paper_move_robot
+    from confront.train.league import paper_move_robot
+    from confront.train.spec import load_experiment
 
     sizes = [SPACE.n_features, 8, 8, sum(SPACE.dims)]
     b2 = np.zeros(sum(SPACE.dims))

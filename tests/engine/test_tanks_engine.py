@@ -19,18 +19,13 @@ from confront.config import ConfigError
 from confront.engine.battle import scenario_battle
 from confront.engine.runner import EngineOptions, run_battle
 from confront.engine.tank_export import TANK_ROBOT, TankPolicy, export_tank_robot, robot_view
-from confront.experiments import tanks_engine
-from confront.experiments.spec import load_experiment
-from confront.experiments.tanks import load_tank_model, ppo_config, tank_space
-from confront.experiments.tanks_engine import (
-    ScoreLog,
-    episode_rewards,
-    pack_episodes,
-    read_decisions,
-    read_scores,
-)
-from confront.experiments.train import train_run
 from confront.learning.ppo import PPO
+from confront.train import ppo_engine
+from confront.train.engine_logs import ScoreLog, read_decisions, read_scores
+from confront.train.factory import train_run
+from confront.train.ppo_engine import episode_rewards, pack_episodes
+from confront.train.ppo_model import load_tank_model, tank_space
+from confront.train.spec import load_experiment
 
 
 def test_rewards_from_the_score_log_by_hand(tmp_path: Path) -> None:
@@ -160,7 +155,7 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
                                            "train.session_rounds=2", "train.checkpoint_every=2", "train.seed=2",
                                            "ppo.hidden=32", "ppo.lr=0.003"])
     out = tmp_path / "run"
-    real, battles = tanks_engine.run_battle, []
+    real, battles = ppo_engine.run_battle, []
 
     def interrupted(*args: object, **kwargs: object) -> object:  # the run is killed while its 2nd battle starts
         if len(battles) == 1:
@@ -168,7 +163,7 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
         battles.append(real(*args, **kwargs))
         return battles[-1]
 
-    monkeypatch.setattr(tanks_engine, "run_battle", interrupted)
+    monkeypatch.setattr(ppo_engine, "run_battle", interrupted)
     with pytest.raises(KeyboardInterrupt):
         train_run(cfg, out, progress=False, engine="robocode")
     first = _read_rows(out / "metrics" / "rounds.csv")
@@ -186,7 +181,7 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
                                                     for r in first), abs=1e-9)
     assert np.isfinite(up["policy_loss"]) and up["approx_kl"] > 0  # the update moved the policy
 
-    monkeypatch.setattr(tanks_engine, "run_battle", real)
+    monkeypatch.setattr(ppo_engine, "run_battle", real)
     summary = train_run(None, out, progress=False, resume=True, engine="robocode")
     rows = _read_rows(out / "metrics" / "rounds.csv")
     assert [int(r["round"]) for r in rows] == [1, 2, 3, 4] and rows[:2] == first
@@ -201,7 +196,7 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
         assert (out / "engine" / f"battle-{b:03d}" / "results.txt").read_text().startswith("Results for 2 rounds")
     # the saved model is the trained one (not the initial weights), in the form evaluate / export read
     trained = load_tank_model(out, cfg)
-    fresh = PPO(tank_space(cfg).n_features, tank_space(cfg).dims, ppo_config(cfg), seed=cfg.train.seed)
+    fresh = PPO(tank_space(cfg).n_features, tank_space(cfg).dims, cfg.ppo, seed=cfg.train.seed)
     assert any(not np.array_equal(a, fresh.actor_arrays()[k]) for k, a in trained.actor_arrays().items())
     assert json.loads((out / "model" / "model.json").read_text())["kind"] == "ppo"
 
@@ -209,7 +204,7 @@ def test_ppo_trains_in_the_engine_and_resumes(install, tmp_path: Path, monkeypat
     cfg2 = load_experiment("tanks-engine", ["league.opponents=['1v1:SittingDuck']", "train.rounds=1",
                                             "train.session_rounds=1", "train.checkpoint_every=1", "ppo.hidden=32",
                                             f"train.init={json.dumps(str(out))}"])
-    trainer = tanks_engine.EngineTankTrainer(cfg2, None)  # type: ignore[arg-type]  # no battle: no run folder
+    trainer = ppo_engine.EngineTankTrainer(cfg2, None)  # type: ignore[arg-type]  # no battle: no run folder
     try:
         for k, a in trained.state_dict().items():
             if k.startswith("net."):

@@ -93,8 +93,9 @@ def test_arms_of_one_seed_share_the_world_and_the_opponent(tiny: Path) -> None:
     from confront.arena.smdp import TeamBattleEnv
     from confront.config import to_dict
     from confront.experiments.reproduce import awm, fuzzy, transfer
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import scenario_of, smdp_config, td_team
+    from confront.train.league import td_team
+    from confront.train.paper_model import scenario_of, smdp_config
+    from confront.train.spec import load_experiment
 
     for build in (awm, fuzzy, transfer):
         jobs, _ = build(2, tiny, np.random.default_rng(0), 4)

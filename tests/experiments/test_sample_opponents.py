@@ -12,8 +12,8 @@ from confront.arena.scenarios import SAMPLE_TEAMS, get_scenario
 from confront.cli.main import cli
 from confront.config import ConfigError
 from confront.engine import battle
-from confront.experiments import spec
-from confront.experiments.spec import load_experiment
+from confront.train import spec
+from confront.train.spec import load_experiment
 
 
 def test_the_opponent_names_agree_everywhere() -> None:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from confront.experiments.stats import (
+from confront.stats import (
     bootstrap_ci,
     hedges_g,
     interval,

@@ -10,10 +10,12 @@ import pytest
 from confront import checkpoint as ck
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.tank import OWN_FEATURES, TankSpace, action_table, lead_point, tank_view_row
-from confront.experiments.spec import load_experiment
-from confront.experiments.tanks import TankTrainer, evaluate_tanks, share_by_opponent
-from confront.experiments.train import new_run, train_run
+from confront.experiments.tank_evaluate import evaluate_tanks
 from confront.runs import Run
+from confront.train.factory import train_run
+from confront.train.loop import new_run, share_by_opponent
+from confront.train.ppo_sim import TankTrainer
+from confront.train.spec import load_experiment
 
 
 def test_view_hand_computed() -> None:
@@ -138,7 +140,7 @@ def test_compare_entries_and_paired_verdicts(tmp_path) -> None:
     league = ("1v1:SpinBot", "1v1:dodge", "1v1:self", "4v4:td", "1v1:td", "4v4:Walls", "4v10:SpinBot")
     assert compare_entries(league) == ["1v1:SpinBot", "1v1:dodge", "4v4:td", "4v4:Walls"]
     # 5 seeds, ours ahead of every method by 0.1 on each: the sign-flip p is 1/32 (all 32 flips enumerated)
-    from confront.experiments.stats import paired_comparison
+    from confront.stats import paired_comparison
 
     ours = np.array([0.9, 0.8, 0.85, 0.95, 0.7])
     pc = paired_comparison(ours, ours - 0.1, np.random.default_rng(0))
@@ -166,7 +168,7 @@ def test_welch_comparison_hand_computed() -> None:
 
 def test_demo_contrast_windows_and_figure(tmp_path) -> None:
     from confront.experiments.demo import plot_contrast
-    from confront.experiments.tanks import share_windows
+    from confront.train.loop import share_windows
 
     rows = [{"opponent": "4v4:td", "score_ours": 3.0 * (k >= 10), "score_theirs": 1.0} for k in range(20)]
     assert share_windows(rows, 10) == [(10, 0.0), (20, 0.75)]
@@ -203,10 +205,9 @@ def test_focus_weights_per_entry() -> None:
 
 def test_polyak_average_is_a_config_key() -> None:
     from confront.config import ConfigError
-    from confront.experiments.tanks import ppo_config
 
-    assert ppo_config(load_experiment("tanks-demo", ["ppo.ema_decay=0.95"])).ema_decay == 0.95
-    assert ppo_config(load_experiment("tanks-demo")).ema_decay == 0.0  # off unless a config asks for it
+    assert load_experiment("tanks-demo", ["ppo.ema_decay=0.95"]).ppo.ema_decay == 0.95
+    assert load_experiment("tanks-demo").ppo.ema_decay == 0.0  # off unless a config asks for it
     with pytest.raises(ConfigError, match="ema_decay"):
         load_experiment("tanks-demo", ["ppo.ema_decay=1.0"])
 
@@ -237,8 +238,8 @@ def test_report_engine_over_runs(tmp_path) -> None:
 def test_paper_move_values_have_the_opponents_choices_as_maxima() -> None:
     """The tables the engine's PolicyBot plays (random ties) draw from the moves the simulator's opponents do."""
     from confront.arena.observe import N_STATES
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.tanks import dodge_policy, paper_move_values
+    from confront.train.league import dodge_policy, paper_move_values
+    from confront.train.spec import load_experiment
 
     cfg = load_experiment("tanks-demo")
     disc = np.repeat(np.arange(N_STATES), 64)
@@ -255,7 +256,7 @@ def test_evaluate_cli_samples_by_default_and_plays_greedy_on_request(tmp_path) -
     from click.testing import CliRunner
 
     from confront.cli.main import cli
-    from confront.experiments.tanks import load_tank_model
+    from confront.train.ppo_model import load_tank_model
 
     cfg = _cfg(tmp_path, "1v1:SpinBot", **{"league.battles": "2", "train.rounds": "8"})
     train_run(cfg, tmp_path / "run", progress=False)
@@ -287,9 +288,9 @@ def test_baseline_cache_is_kept_per_td_team(tmp_path) -> None:
 def test_engine_comparison_caches_each_battle_and_plays_the_td_team_as_policybots(tmp_path, monkeypatch) -> None:
     from confront.engine import evaluate as engine_evaluate
     from confront.experiments.baselines import RANDOM_METHOD
-    from confront.experiments.episodes import save_model
     from confront.experiments.tank_compare import engine_method_shares
     from confront.learning.tabular import TabularQ
+    from confront.train.paper_model import save_model
 
     td = tmp_path / "td" / "abcd"
     save_model(td, TabularQ(), {})
@@ -325,8 +326,8 @@ def test_engine_comparison_caches_each_battle_and_plays_the_td_team_as_policybot
 
 
 def test_engine_comparison_pairs_each_seed_with_the_reports_engine_mean(tmp_path, monkeypatch) -> None:
-    from confront.experiments import episodes
     from confront.experiments import tank_compare as tc
+    from confront.train import league
 
     entries = ["1v1:SittingDuck", "1v1:dodge", "4v4:td"]
     ours = {e: [[0.5 + 0.1 * k, 0.6 + 0.1 * k, 0.7 + 0.1 * k] for k in range(5)] for e in entries}
@@ -342,7 +343,7 @@ def test_engine_comparison_pairs_each_seed_with_the_reports_engine_mean(tmp_path
         return {"1v1:SittingDuck": 1.0, "1v1:dodge": 0.5 + 0.1 * seed, "4v4:td": 0.5 + 0.1 * seed}
 
     monkeypatch.setattr(tc, "engine_method_shares", shares)
-    monkeypatch.setattr(episodes, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
+    monkeypatch.setattr(league, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
     res = tc.compare_engine(tmp_path / "results.json", tmp_path / "out", 7, tmp_path / "work")
     assert res["seeds"] == [0, 1, 2, 3, 4] and res["entries"] == ["1v1:SittingDuck", "1v1:dodge", "4v4:td"]
     assert calls[:3] == [(m, 0, "/c/td/t0", 7, 1) for m in tc.METHODS] and len(calls) == 15
@@ -365,7 +366,7 @@ def test_engine_comparison_pairs_each_seed_with_the_reports_engine_mean(tmp_path
 
 def test_the_baselines_face_the_dodge_as_its_own_policy_draws() -> None:
     from confront.experiments.tank_compare import dodge_learner
-    from confront.experiments.tanks import dodge_policy
+    from confront.train.league import dodge_policy
 
     states = np.repeat(np.arange(320), 200)
     ours = dodge_learner(load_experiment("tanks", ())).act(states, np.random.default_rng(1), explore=False)
@@ -378,8 +379,8 @@ def test_the_baselines_face_the_dodge_as_its_own_policy_draws() -> None:
 
 
 def test_report_comparison_pairs_named_seeds_and_falls_back_to_welch(tmp_path, monkeypatch) -> None:
-    from confront.experiments import episodes
     from confront.experiments import tank_compare as tc
+    from confront.train import league
 
     entries = ["1v1:SittingDuck", "4v4:td"]
     # the report lists its runs seed4 .. seed0; run seedK's share is 0.6 + 0.1 K
@@ -392,7 +393,7 @@ def test_report_comparison_pairs_named_seeds_and_falls_back_to_welch(tmp_path, m
         return {"1v1:SittingDuck": 1.0, "4v4:td": 0.5 + 0.1 * seed}  # 0.1 below PPO tanks' share at every seed
 
     monkeypatch.setattr(tc, "method_shares", shares)
-    monkeypatch.setattr(episodes, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
+    monkeypatch.setattr(league, "td_team", lambda cfg, n: (None, Path(f"/c/td/t{cfg.train.seed}")))
     for runs, seeds, test in (([f"seed{4 - k}" for k in range(5)], [4, 3, 2, 1, 0], "paired"),
                               (["a", "b", "c", "d", "e"], [0, 1, 2, 3, 4], "welch")):
         calls.clear()
@@ -437,7 +438,7 @@ def test_report_end_to_end_from_a_trained_run(tmp_path) -> None:
     import sys
 
     from confront.experiments.tank_report import report
-    from confront.experiments.tanks import load_tank_model
+    from confront.train.ppo_model import load_tank_model
 
     cfg = _cfg(tmp_path, "1v1:SittingDuck,1v1:SpinBot", **{"league.battles": "2", "train.rounds": "12"})
     run = tmp_path / "run"

@@ -111,8 +111,9 @@ def test_corrupt_checkpoint_is_refused_and_kept(reference: tuple[Path, Path], tm
 
 def test_random_reference_and_true_sensing_are_config_choices(tmp_path: Path,
                                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import smdp_config, train_run
+    from confront.train.factory import train_run
+    from confront.train.paper_model import smdp_config
+    from confront.train.spec import load_experiment
 
     monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path / "cache"))
     small = ["train.rounds=8", "train.session_rounds=4", "arena.battles=2", "opponent.pretrain_rounds=2",
@@ -145,8 +146,8 @@ def test_one_loop_logs_every_learner_to_tensorboard(reference: tuple[Path, Path]
 
 def test_ppo_league_the_engine_cannot_play_is_refused_before_a_run_folder_is_left(tmp_path: Path) -> None:
     from confront.config import ConfigError
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import train_run
+    from confront.train.factory import train_run
+    from confront.train.spec import load_experiment
 
     with pytest.raises(ConfigError, match="'1v1:strafe' cannot be played in the engine"):  # the first of tanks.toml's
         train_run(load_experiment("tanks"), tmp_path / "run", progress=False, engine="robocode")

@@ -27,8 +27,8 @@ TINY = ("--set", "train.rounds=4", "--set", "train.session_rounds=2", "--set", "
 @pytest.fixture(scope="module")
 def ws(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A workspace: a small trained run, a resumable copy, broken copies, and bad files of every kind."""
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import train_run
+    from confront.train.factory import train_run
+    from confront.train.spec import load_experiment
 
     root = tmp_path_factory.mktemp("ws")
     cfg = load_experiment("demo", [t for t in TINY if t != "--set"])
@@ -265,8 +265,8 @@ def test_missing_engine_is_one_line_and_no_run_folder(ws: Path, monkeypatch: pyt
 
 
 def test_corrupt_td_cache_is_rebuilt_aloud(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from confront.experiments.spec import load_experiment
-    from confront.experiments.train import td_team
+    from confront.train.league import td_team
+    from confront.train.spec import load_experiment
 
     monkeypatch.setenv("CONFRONT_CACHE", str(tmp_path))
     cfg = load_experiment("demo", ["opponent.pretrain_rounds=2"])
@@ -296,11 +296,11 @@ def test_missing_latest_resumes_from_the_newest_checkpoint_aloud(ws: Path, tmp_p
 
 
 def test_demo_rounds_below_its_session_are_allowed(monkeypatch: pytest.MonkeyPatch) -> None:
-    import confront.experiments.train as train
+    from confront.train import factory, loop
 
     got = []
-    monkeypatch.setattr(train, "train_run", lambda cfg, out, progress: got.append(cfg) or {})
-    monkeypatch.setattr(train, "print_summary", lambda summary: None)
+    monkeypatch.setattr(factory, "train_run", lambda cfg, out, progress: got.append(cfg) or {})
+    monkeypatch.setattr(loop, "print_summary", lambda summary: None)
     result = CliRunner().invoke(cli, ["demo", "--rounds", "8", "--out", "unused"])
     assert result.exit_code == 0, result.output
     assert (got[0].train.rounds, got[0].train.session_rounds) == (8, 8)

@@ -26,7 +26,7 @@ from confront import checkpoint as ck
 from confront.arena.replay import Replay, ReplayError, load_replay
 from confront.config import ConfigError, from_dict, to_dict, to_toml
 from confront.engine.bridge import LineReader, parse_end, parse_hello, parse_history, parse_observation
-from confront.experiments.spec import ExperimentConfig, experiment_data, load_experiment
+from confront.train.spec import ExperimentConfig, experiment_data, load_experiment
 
 EXAMPLES = int(os.environ.get("CONFRONT_FUZZ_EXAMPLES", "200"))
 FUZZ = settings(max_examples=EXAMPLES, deadline=None, database=None,

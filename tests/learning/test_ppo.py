@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 import torch
 
-from confront.learning.ppo import PPO, PPOConfig, Rollout, Tanh, gae, greedy_joint, team_mean
+from confront.config import ConfigError, from_dict, to_dict
+from confront.learning.ppo import PPO, Rollout, Tanh, gae, greedy_joint, team_mean
+from confront.learning.ppo_config import PPOConfig
 
 
 def test_gae_hand_computed() -> None:
@@ -93,14 +95,23 @@ def test_bad_state_and_config_refused() -> None:
     a = PPO(2, (2, 3), PPOConfig(hidden=8))
     with pytest.raises(ValueError, match="does not fit"):
         a.load_state_dict(PPO(3, (2, 3), PPOConfig(hidden=8)).state_dict())
-    with pytest.raises(ValueError, match="ppo.rollout_steps"):
-        PPOConfig(rollout_steps=0)
-    with pytest.raises(ValueError, match="ppo.threads"):
-        PPOConfig(threads=0)
-    with pytest.raises(ValueError, match="ppo.precision must be one of fp32, bf16, bf16-hidden"):
-        PPOConfig(precision="fp16")
-    with pytest.raises(ValueError, match="ppo.critic_hidden must be an integer >= 0"):
-        PPOConfig(critic_hidden=-1)
+    for key, value, message in (("rollout_steps", 0, "out of range: must be >= 1"),
+                                ("threads", 0, "out of range: must be >= 1"),
+                                ("precision", "fp16", "not allowed: use one of 'fp32', 'bf16', 'bf16-hidden'"),
+                                ("critic_hidden", -1, "out of range: must be >= 0"),
+                                ("threads", 2.0, "the wrong type: expected an integer")):
+        with pytest.raises(ConfigError, match=f"ppo.{key} = .* (is|has) {message}"):
+            from_dict(PPOConfig, {key: value}, prefix="ppo")  # checked where a config is read
+
+
+def test_one_config_type_for_the_learner_and_the_configs() -> None:
+    """A config's [ppo] section is the learner's PPOConfig, its defaults the ones the shipped configs rely on."""
+    from confront.train.spec import ExperimentConfig, load_experiment
+
+    assert type(ExperimentConfig().ppo) is PPOConfig and ExperimentConfig().ppo == PPOConfig()
+    assert (PPOConfig().lr, PPOConfig().gamma, PPOConfig().threads) == (2.5e-3, 0.97, 2)
+    cfg = load_experiment("tanks-demo", ["ppo.lr=0.001"])
+    assert cfg.ppo == from_dict(PPOConfig, {**to_dict(PPOConfig()), **to_dict(cfg.ppo)}) and cfg.ppo.lr == 1e-3
 
 
 def test_critic_hidden_sizes_the_critic_only() -> None:
@@ -191,8 +202,8 @@ def test_entropy_coefficient_anneals_linearly() -> None:
     assert entropy_coef(c, 0) == 0.01 and entropy_coef(c, 100) == 0.002 and entropy_coef(c, 500) == 0.002
     assert entropy_coef(c, 25) == pytest.approx(0.008)
     assert entropy_coef(PPOConfig(ent_coef=0.03), 10_000) == 0.03  # off by default
-    with pytest.raises(ValueError, match="ent_anneal_updates"):
-        PPOConfig(ent_anneal_updates=-1)
+    with pytest.raises(ConfigError, match="ppo.ent_anneal_updates = -1 is out of range"):
+        from_dict(PPOConfig, {"ent_anneal_updates": -1}, prefix="ppo")
 
 
 def test_polyak_average_of_the_actor_hand_computed() -> None:
@@ -213,8 +224,8 @@ def test_polyak_average_of_the_actor_hand_computed() -> None:
         p.adopt_average()
         for k, v in p.actor_arrays().items():
             np.testing.assert_allclose(v, expected[k], rtol=1e-5, atol=1e-6, err_msg=k)
-    with pytest.raises(ValueError, match="ppo.ema_decay"):
-        PPOConfig(ema_decay=1.0)
+    with pytest.raises(ConfigError, match="ppo.ema_decay = 1.0 is out of range"):
+        from_dict(PPOConfig, {"ema_decay": 1.0}, prefix="ppo")
 
 
 def test_learning_rate_anneals_linearly_to_zero() -> None:

@@ -42,7 +42,7 @@ import robocode.control.snapshot.ITurnSnapshot;
  * a JSONL trace of every turn. Arguments: WORKDIR BATTLE_FILE RESULTS_FILE SUMMARY_FILE [TRACE_FILE].
  *
  * <p>With the JVM property confront.scores=PATH it also writes each robot's current-round score per turn
- * (PPO training in the engine, confront.experiments.tanks_engine): a line "round turn alive s_0 ... s_n-1"
+ * (PPO training in the engine, confront.train.ppo_engine): a line "round turn alive s_0 ... s_n-1"
  * (robots in snapshot order, alive a string of 0/1, scores by Double.toString) at each round's first turn and
  * whenever a score or a robot's life changed since the line before.
  */

@@ -35,7 +35,7 @@ import robocode.util.Utils;
  * <p>Robocode makes a new robot object each round, so the memory starts empty every round. A team-mate's
  * broadcast arrives one turn later, so mates are seen as they were a turn ago (and not at all at turn 0).
  *
- * <p>Training in the engine (confront.experiments.tanks_engine; needs -DNOSECURITY=true): the JVM property
+ * <p>Training in the engine (confront.train.ppo_engine; needs -DNOSECURITY=true): the JVM property
  * confront.tank.model names a policy file read instead of TankData, and confront.tank.log a folder where each
  * robot appends one line per decision to its own file (LOG_SUFFIX): name, round, turn, joint action, the view
  * (Double.toString, exact), the uniform draws, and with confront.tank.log.detail=true what the view was made

@@ -1,0 +1,78 @@
+"""Which trainer trains a config, and the run it trains into: :func:`train_run` (``confront train``).
+
+    config -> make_trainer (learner x backend) -> loop.run_trainer -> run folder, summary
+
+    the paper's learners (dmnn, ssaq, random):  sim: paper_sim.SMDPTrainer   robocode: paper_engine.EngineTrainer
+    ppo:                                        sim: ppo_sim.TankTrainer     robocode: ppo_engine.EngineTankTrainer
+
+Each backend's modules are imported only when its trainer is made.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from confront.config import ConfigError
+from confront.runs import Run
+from confront.train.loop import Trainer, new_run, resume_run, run_trainer
+from confront.train.spec import ExperimentConfig
+
+__all__ = ["ENGINES", "make_trainer", "trainer_class", "train_run"]
+
+ENGINES = ("sim", "robocode")
+
+
+def make_trainer(cfg: ExperimentConfig, run: Run, engine: str = "sim", progress: bool = False,
+                 cpu_constant_ms: float | None = None) -> Trainer:
+    """The trainer of ``cfg``'s learner on ``engine`` (imports the backend it needs only)."""
+    if engine not in ENGINES:
+        raise ConfigError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if cfg.train.init and cfg.learner.kind != "ppo":
+        raise ConfigError("train.init starts a PPO learner from a run's model; for the paper's learners use "
+                          "transfer.source")
+    if cfg.train.init and engine != "robocode":
+        raise ConfigError("train.init (a PPO run to start from) is used in the engine only (--engine robocode)")
+    return trainer_class(cfg.learner.kind, engine).from_config(cfg, run, progress, cpu_constant_ms)
+
+
+def trainer_class(learner: str, engine: str) -> type[Trainer]:
+    """The trainer of ``learner`` (``learner.kind``: ppo, or one of the paper's) on ``engine``."""
+    if learner == "ppo":
+        if engine == "robocode":
+            from confront.train.ppo_engine import EngineTankTrainer
+
+            return EngineTankTrainer
+        from confront.train.ppo_sim import TankTrainer
+
+        return TankTrainer
+    if engine == "robocode":
+        from confront.train.paper_engine import EngineTrainer
+
+        return EngineTrainer
+    from confront.train.paper_sim import SMDPTrainer
+
+    return SMDPTrainer
+
+
+def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool = False, progress: bool = True,
+              exist_ok: bool = False, engine: str = "sim", cpu_constant_ms: float | None = None) -> dict[str, Any]:
+    """Train ``cfg``'s learner on ``engine`` ("sim" or "robocode") into a run folder, or continue the run in
+    ``out`` with ``resume`` (its own config); return the summary."""
+    t_setup = time.time()
+    if resume:
+        run, cfg = resume_run(out)
+    elif cfg is None:
+        raise ValueError("train_run needs a config unless resuming")
+    else:
+        run = new_run(cfg, out, exist_ok)
+    try:
+        trainer = make_trainer(cfg, run, engine, progress=progress, cpu_constant_ms=cpu_constant_ms)
+    except Exception:
+        run.discard_if_new()  # a failed start leaves no half-made run folder
+        raise
+    try:
+        return run_trainer(cfg, run, trainer, resume, progress, setup_s=time.time() - t_setup)
+    finally:
+        trainer.close()

@@ -41,7 +41,7 @@ from confront.engine.rumble import (
     run_jobs,
     write_json_atomic,
 )
-from confront.experiments.stats import t_interval
+from confront.stats import t_interval
 
 
 @dataclass(frozen=True)

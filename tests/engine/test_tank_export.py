@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from confront.arena.control import ControlConfig
-from confront.checkpoint import CheckpointError
 from confront.arena.smdp import SMDPConfig, TeamBattleEnv
 from confront.arena.tank import TankSpace
+from confront.checkpoint import CheckpointError
 from confront.engine.java_build import compile_java
 from confront.engine.tank_export import (
     TankPolicy,

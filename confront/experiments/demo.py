@@ -8,6 +8,7 @@ from pathlib import Path
 
 import click
 
+from confront.cli import command
 from confront.runs import new_run_name
 from confront.train.spec import load_experiment
 
@@ -43,17 +44,22 @@ def run_demo(out: Path | None = None, rounds: int | None = None, seed: int | Non
         fig = plot_contrast(out, out / "paper-arm")
         summary["figures"] = [*summary.get("figures", []), str(fig)]
         click.echo(f"\ncontrast figure: {fig}")
+    c = command()  # as the user started it: .venv/bin/confront after the README's commands
+    replay = summary.get("replay")
+    watch = (f"  open {Path(replay).parent / 'last_round.html'}\n      a recorded round of the trained team "
+             "(HTML player; a GIF beside it)\n") if replay else ""
     click.echo(
         "\nNext:\n"
-        f"  open {out}/plots/*.png                    the learning curves\n"
-        f"  tensorboard --logdir {out}/tb             shares per opponent, losses, entropy, decisions/s\n"
-        f"  confront evaluate {out} --rounds 100      play the trained team per opponent (score table)\n"
-        f"  confront export {out} --out MyTank.jar    a Robocode robot that runs the policy without Python\n"
-        f"  confront robocode {out}                   Robocode's own program with it (pick confront.TankTeam 1.0)\n"
-        f"  confront evaluate {out} --engine robocode --watch --opponents 1v1:SpinBot --rounds 3\n"
-        "                                             watch it in Robocode's own window (apt-get install robocode)\n"
-        "  confront train -c tanks                    the whole league (every sample robot, 1v1 and teams)\n"
-        "  confront demo --paper                      the paper's fuzzy DMNN arm, for contrast\n"
+        f"{watch}"
+        f"  open {out}/plots/*.png\n      the learning curves\n"
+        f"  tensorboard --logdir {out}/tb\n      shares per opponent, losses, entropy, decisions/s\n"
+        f"  {c} evaluate {out} --rounds 100\n      play the trained team per opponent (score table)\n"
+        f"  {c} export {out} --out MyTank.jar\n      a Robocode robot that runs the policy without Python\n"
+        f"  {c} robocode {out}\n      Robocode's own program with it (pick confront.TankTeam 1.0)\n"
+        f"  {c} evaluate {out} --engine robocode --watch --opponents 1v1:SpinBot --rounds 3\n"
+        "      watch it in Robocode's own window (apt-get install robocode)\n"
+        f"  {c} train -c tanks\n      the whole league (every sample robot, 1v1 and teams)\n"
+        f"  {c} demo --paper\n      the paper's fuzzy DMNN arm, for contrast\n"
     )
     return summary
 

@@ -51,6 +51,10 @@ def evaluate_tanks(cfg: ExperimentConfig, ppo: PPO, rounds: int, seed: int = 10_
                 "rounds": done[k]} for k in shares}
 
 
+SHARE = ("score share: our team's Robocode score / both teams' scores (0.5 is even), the same measure in the "
+         "simulator and in Robocode")
+
+
 def league_entries(opponents: str | None, cfg: ExperimentConfig) -> tuple[str, ...]:
     """``--opponents`` as league entries: ``SCENARIO:OPPONENT`` kept, a bare name is ``1v1:NAME``."""
     if not opponents:
@@ -71,12 +75,12 @@ def evaluate_tank_cli(run: Path, opponents: str | None, rounds: int, seed: int, 
     entries = league_entries(opponents, cfg)
     try:
         cfg = replace(cfg, league=replace(cfg.league, opponents=entries, focus=()))
-    except ValueError as exc:
-        raise click.UsageError(str(exc)) from None
+    except ValueError as exc:  # the config's words for what the user typed as --opponents
+        raise click.UsageError(str(exc).replace("league.opponents entry", "--opponents entry")) from None
     ppo = load_tank_model(run, cfg)
     res = evaluate_tanks(cfg, ppo, rounds, seed=seed, explore=play == "sampled")
-    click.echo(f"\n{run}: {play} policy, {rounds} rounds per opponent (simulator, seed {seed})\n")
-    click.echo("| opponent | rounds | score share | win rate |\n|---|---:|---:|---:|")
+    click.echo(f"\n{run}: {play} policy, {rounds} rounds per opponent (simulator, seed {seed})\n{SHARE}\n")
+    click.echo("| opponent | rounds | score share (simulator) | win rate |\n|---|---:|---:|---:|")
     for name in entries:
         r = res[name]
         click.echo(f"| {name} | {r['rounds']} | {r['share']:.3f} | {r['win_rate']:.2f} |")
@@ -96,8 +100,8 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
     policy = load_tank_policy(run, play)
     out: dict[str, list[float]] = {}
     click.echo(f"\n{run}: the exported TankBot ({play}) in Robocode, {rounds} rounds x {seeds} battle(s) per "
-               "opponent\n")
-    click.echo("| opponent | battles | score ratio (robocode) |\n|---|---:|---:|")
+               f"opponent\n{SHARE}\n")
+    click.echo("| opponent | battles | score share (robocode) |\n|---|---:|---:|")
     for entry in league_entries(opponents, cfg):
         scen, _, opp = entry.partition(":")
         if opp not in BOT_NAMES and opp not in SAMPLE_TEAMS:

@@ -168,8 +168,6 @@ class Loop:
 
 def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | None = None) -> str | None:
     """One greedy round of the trained team in a single fresh battle, as replay JSON + GIF + HTML."""
-    from confront.arena import replay as rp
-
     env = TeamBattleEnv(scenario_of(cfg.arena.scenario), n_battles=1,
                         seed=cfg.train.seed + 1000 if seed is None else seed,
                         opponents="td" if side.opponent is not None else cfg.opponent.kind,
@@ -179,10 +177,15 @@ def record_round(cfg: ExperimentConfig, side: Side, out_dir: Path, seed: int | N
     while loop.rounds_done < 1:
         loop.step()
     replay = env.stop_recording()
-    if replay is None:
-        return None
+    return write_replay(replay, out_dir, f"confront: {cfg.name}") if replay is not None else None
+
+
+def write_replay(replay: Any, out_dir: Path, title: str) -> str:
+    """A recorded round as ``out_dir/last_round.replay.json.gz`` with a GIF and an HTML player beside it."""
+    from confront.arena import replay as rp
+
     out_dir.mkdir(parents=True, exist_ok=True)
     path = replay.save(out_dir / "last_round.replay.json.gz")
     rp.write_gif(replay, out_dir / "last_round.gif")
-    rp.write_html(replay, out_dir / "last_round.html", title=f"confront: {cfg.name}")
+    rp.write_html(replay, out_dir / "last_round.html", title=title)
     return str(path)

@@ -62,17 +62,20 @@ def train_run(cfg: ExperimentConfig | None, out: str | Path | None, resume: bool
     ``out`` with ``resume`` (its own config); return the summary."""
     t_setup = time.time()
     if resume:
-        run, cfg = resume_run(out)
+        run, cfg = resume_run(out)  # the run folder's lock held from here (runs.RunLock)
     elif cfg is None:
         raise ValueError("train_run needs a config unless resuming")
     else:
         run = new_run(cfg, out, exist_ok)
     try:
         trainer = make_trainer(cfg, run, engine, progress=progress, cpu_constant_ms=cpu_constant_ms)
-    except Exception:
-        run.discard_if_new()  # a failed start leaves no half-made run folder
+    except BaseException:
+        run.discard_if_new()  # a failed start leaves no half-made run folder (and drops the lock)
         raise
     try:
         return run_trainer(cfg, run, trainer, resume, progress, setup_s=time.time() - t_setup)
     finally:
-        trainer.close()
+        try:
+            trainer.close()
+        finally:
+            run.release()

@@ -18,7 +18,10 @@ here too what the summaries make of them: pooled shares, sessions, shares per op
 
 from __future__ import annotations
 
+import hashlib
 import math
+import signal
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -29,10 +32,11 @@ import numpy as np
 
 from confront import checkpoint as ck
 from confront.config import load_toml, to_dict
-from confront.runs import Run
+from confront.runs import Interrupted, Run
 from confront.train.spec import ExperimentConfig, config_from_dict
 
-__all__ = ["Trainer", "run_rounds", "run_trainer", "new_run", "resume_run", "pooled_share", "session_rows",
+__all__ = ["Trainer", "RunFinished", "run_rounds", "run_trainer", "new_run", "resume_run",
+           "pooled_share", "session_rows",
            "share_by_opponent", "share_windows", "print_summary"]
 
 
@@ -163,22 +167,94 @@ def run_rounds(trainer: Any, rounds: int, progress: bool, desc: str | None = Non
 
 # -- run folders -------------------------------------------------------------------------------------------------
 
+class RunFinished(FileExistsError):
+    """``--resume`` of a run that ended (it has its summary.json): nothing is trained again."""
+
+
 def resume_run(out: str | Path | None) -> tuple[Run, ExperimentConfig]:
-    """An existing run folder and the config it was started with (for ``--resume``)."""
+    """An existing run folder, locked for this run, and the config it was started with (for ``--resume``);
+    :class:`RunFinished` if it ended."""
     if out is None:
         raise ValueError("resume needs the run folder")
-    run = Run(Path(out))
-    if not (run.path / "config.toml").exists():
-        raise FileNotFoundError(f"{run.path} is not a run folder (no config.toml)")
-    return run, config_from_dict(load_toml(run.path / "config.toml"))
+    path = Path(out)
+    if not (path / "config.toml").exists():
+        raise FileNotFoundError(f"{path} is not a run folder (no config.toml)")
+    run = Run.open(path)
+    try:
+        if (path / "summary.json").exists():
+            raise RunFinished(f"{path} is finished (it has its summary.json): nothing to resume; train longer in a "
+                              "new run (confront train -c CONFIG --set train.rounds=N)")
+        return run, config_from_dict(load_toml(path / "config.toml"))
+    except BaseException:
+        run.release()
+        raise
 
 
 def new_run(cfg: ExperimentConfig, out: str | Path | None, exist_ok: bool = False) -> Run:
-    """A new run folder ``out`` (default ``runs/<name>-<time>``) holding the resolved config."""
+    """A new run folder ``out`` (default ``runs/<name>-<time>``) holding the resolved config, locked for this
+    run until :meth:`Run.release`."""
     from confront.runs import new_run_name
 
     return Run.create(Path(out) if out is not None else Path("runs") / new_run_name(cfg.name), to_dict(cfg),
-                      exist_ok=exist_ok)
+                      exist_ok=exist_ok, lock=True)
+
+
+def _config_digest(run: Run) -> str:
+    """SHA-256 of the run's config.toml: a checkpoint records it, a resume compares it."""
+    return hashlib.sha256((run.path / "config.toml").read_bytes()).hexdigest()
+
+
+def _check_fits(fresh: tuple[dict[str, np.ndarray], dict[str, Any]], arrays: dict[str, np.ndarray],
+                meta: dict[str, Any], where: Path) -> None:
+    """A checkpoint's arrays and counters against what this config's trainer holds (``fresh``, its state before
+    loading): every array both have of one shape and type, every counter a whole number >= 0 of the same kind,
+    every other metadata value of the same type; CheckpointError naming the first that is not."""
+    ref_arrays, ref_meta = fresh
+    for k in sorted(set(ref_arrays) & set(arrays)):
+        a, r = arrays[k], ref_arrays[k]
+        if a.shape != r.shape or a.dtype.kind != r.dtype.kind:
+            raise ck.CheckpointError(f"{where}: array {k} is {a.dtype.kind}{list(a.shape)}, this run's config makes "
+                                     f"{r.dtype.kind}{list(r.shape)}")
+    for k in sorted(set(ref_meta) & set(meta)):
+        v, r = meta[k], ref_meta[k]
+        if isinstance(r, bool) or isinstance(v, bool):
+            ok = isinstance(r, bool) and isinstance(v, bool)
+        elif isinstance(r, int):
+            ok = isinstance(v, int) and v >= 0
+        elif isinstance(r, float):
+            ok = isinstance(v, int | float) and math.isfinite(v)
+        else:
+            ok = type(v) is type(r)
+        if not ok:
+            raise ck.CheckpointError(f"{where}: {k} = {str(v)[:40]} does not fit this run ({type(r).__name__})")
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class _StopOnSignal:
+    """Ctrl-C (or SIGTERM) during training sets :attr:`asked`; the loop saves after the step it is in and stops. A
+    second Ctrl-C interrupts at once (KeyboardInterrupt). Outside the main thread nothing is installed."""
+
+    def __init__(self) -> None:
+        self.asked = False
+        self._old: dict[int, Any] = {}
+
+    def __enter__(self) -> _StopOnSignal:
+        if threading.current_thread() is threading.main_thread():
+            for sig in STOP_SIGNALS:
+                self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        if self.asked:
+            raise KeyboardInterrupt
+        self.asked = True
+        click.echo("\nstopping after this step (a checkpoint is saved; Ctrl-C again to stop at once)", err=True)
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
 
 
 def _log(writer: Any, trainer: Trainer, scalars: dict[str, float], window: int) -> None:
@@ -201,34 +277,51 @@ def run_trainer(cfg: ExperimentConfig, run: Run, trainer: Trainer, resume: bool,
     from torch.utils.tensorboard import SummaryWriter
 
     elapsed_before = 0.0
+    digest = _config_digest(run)
     if resume and (latest := ck.latest(run.checkpoints)) is not None:
         arrays, meta = ck.load(latest)
         if meta.get("engine", "sim") != trainer.engine:
             raise ck.CheckpointError(f"{latest} was trained with --engine {meta.get('engine', 'sim')}: resume it "
                                      f"with that engine")
+        if meta.get("config_sha256", digest) != digest:  # checkpoints of older versions carry no digest
+            raise ck.CheckpointError(f"{run.path / 'config.toml'} was edited after {latest.name} was saved: put it "
+                                     "back, or start a new run with the edited config (confront train -c FILE)")
+        _check_fits(trainer.state(), arrays, meta, latest)
         trainer.load(arrays, meta)
         elapsed_before = float(meta.get("elapsed_s", 0.0))
-        if progress:
-            click.echo(f"resuming {run.path} from {latest.name} ({trainer.rounds_done} rounds done)")
+        click.echo(f"resuming {run.path} from {latest.name} ({trainer.rounds_done} rounds done)", err=not progress)
+    elif resume:
+        click.echo(f"note: {run.path} has no checkpoint yet: training starts from round 0", err=True)
     tc = cfg.train
     total, every, window = tc.rounds, tc.checkpoint_every, min(tc.session_rounds, 200)
     start = time.time()
     next_ckpt = (trainer.rounds_done // every + 1) * every
-    writer = SummaryWriter(str(run.path / "tb"))
+    # a resumed run's scalars past its checkpoint were logged before the kill: TensorBoard drops them (purge_step)
+    writer = SummaryWriter(str(run.path / "tb"), purge_step=trainer.decisions + 1 if resume else None)
     in_csv = 0  # rows in metrics/rounds.csv (rewritten whole at the first checkpoint, also after a resume)
+    stop = _StopOnSignal()
+
+    def save() -> str:
+        nonlocal in_csv
+        arrays, meta = trainer.state()
+        meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start, config_sha256=digest)
+        name = f"round-{trainer.rounds_done:06d}"
+        ck.save(run.checkpoints, name, arrays, meta)
+        in_csv = run.append_table("rounds", trainer.rows, in_csv)
+        return name
 
     def on_step(scalars: dict[str, float]) -> None:
-        nonlocal next_ckpt, in_csv
+        nonlocal next_ckpt
         _log(writer, trainer, scalars, window)
-        if next_ckpt <= trainer.rounds_done < total:
-            arrays, meta = trainer.state()
-            meta.update(engine=trainer.engine, elapsed_s=elapsed_before + time.time() - start)
-            ck.save(run.checkpoints, f"round-{trainer.rounds_done:06d}", arrays, meta)
-            in_csv = run.append_table("rounds", trainer.rows, in_csv)
+        if next_ckpt <= trainer.rounds_done < total or (stop.asked and trainer.rounds_done < total):
+            name = save()
             next_ckpt = (trainer.rounds_done // every + 1) * every
+            if stop.asked:
+                raise Interrupted(run.path, trainer.rounds_done, run.checkpoints / name)
 
     try:
-        run_rounds(trainer, total, progress, on_step=on_step, window=window)
+        with stop:
+            run_rounds(trainer, total, progress, on_step=on_step, window=window)
     finally:
         writer.close()
     rows = trainer.rows

@@ -7,6 +7,7 @@ plays), ``tank.json`` (actions, view, controller) and ``ppo.npz`` (the whole lea
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -67,7 +68,13 @@ def load_tank_model(folder: str | Path, cfg: ExperimentConfig) -> PPO:
     space = tank_space(cfg)
     ppo = PPO(space.n_features, space.dims, cfg.ppo)
     try:
-        ppo.load_state_dict(_read_npz(p / "ppo.npz"))
-    except (OSError, ValueError, KeyError) as exc:
-        raise ck.CheckpointError(f"model {p} cannot be read: {exc}") from None
+        state = _read_npz(p / "ppo.npz")
+        bad = [k for k, v in state.items() if v.dtype.kind in "fc" and not np.all(np.isfinite(v))]
+        if bad:
+            raise ValueError(f"its arrays {', '.join(bad[:5])} hold NaN or infinite values")
+        ppo.load_state_dict(state)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"no trained PPO model in {folder} (expected model/ppo.npz)") from None
+    except (OSError, ValueError, KeyError, TypeError, RuntimeError, EOFError, zipfile.BadZipFile) as exc:
+        raise ck.CheckpointError(f"model {p} cannot be read: {' '.join(str(exc).split())[:200]}") from None
     return ppo

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -153,9 +154,10 @@ class TankTrainer:
         n = min((len(v) for v in per.values()), default=0)
         if n > 1:
             figs.append(plot_curves({k: np.array(v[:n]) for k, v in per.items()}, run.plots / "share_by_opponent.png",
-                                    ylabel="score share", hline=0.5,
+                                    ylabel="score share", hline=0.5, xlabel=f"window of {window} rounds",
                                     title=f"{cfg.name}: share per opponent ({window}-round windows)"))
-        return {"learner": "ppo", "scenario": "league", "updates": self.ppo.updates,
+        replay = record_tank_round(cfg, self.ppo, run.replays) if cfg.train.replay else None
+        return {"learner": "ppo", "scenario": "league", "updates": self.ppo.updates, "replay": replay,
                 "share_by_opponent_last": share_by_opponent(rows[-min(self.final_window, len(rows)):]),
                 "decisions_per_s": self.decisions / max(self.elapsed, 1e-9), "figures": [str(f) for f in figs]}
 
@@ -185,7 +187,15 @@ class TankTrainer:
                 raise ValueError("not a PPO checkpoint")
             self.pool.load_state_dict(sub("pool."))
             self.ppo.load_state_dict(sub("ppo."))
-            self.snapshots = [sub(f"snap{i}.") for i in range(int(meta["snapshots"]))]
+            n_snaps = int(meta["snapshots"])
+            held = {k.split(".", 1)[0] for k in arrays if k.startswith("snap")}
+            if held != {f"snap{i}" for i in range(n_snaps)}:  # snapshots = 10**8 would loop for hours
+                raise ValueError(f"snapshots = {n_snaps} but it holds {len(held)} snapshot(s)")
+            self.snapshots = [sub(f"snap{i}.") for i in range(n_snaps)]
+            actor = {k: (v.shape, v.dtype.kind) for k, v in self.ppo.actor_arrays().items()}
+            for i, snap in enumerate(self.snapshots):
+                if {k: (v.shape, v.dtype.kind) for k, v in snap.items()} != actor:
+                    raise ValueError(f"snapshot {i} does not fit the actor")
             self.obs = np.asarray(arrays["obs"], dtype=np.float32)
             pending = sub("pending.")
             self.pending = Rollout(**pending) if pending else None
@@ -195,3 +205,31 @@ class TankTrainer:
             self.pool.rng = ck.rng_from_state(meta["pool_rng"])
         except (KeyError, ValueError, TypeError) as exc:
             raise ck.CheckpointError(f"checkpoint does not fit this run's config: {exc}") from None
+
+
+def record_tank_round(cfg: ExperimentConfig, ppo: PPO, out_dir: Path, entry: str | None = None) -> str:
+    """One round of the trained tanks (sampling their heads, as they trained and as the exported robot plays) in a
+    fresh battle of ``entry`` (default the league's first team entry, say ``4v4:td``), as replay JSON + GIF + HTML
+    in ``out_dir``."""
+    from dataclasses import replace
+
+    from confront.train.episodes import write_replay
+
+    names = list(cfg.league.opponents)
+    entry = entry or next((e for e in names if not e.startswith("1v1:")), names[0])
+    pool, snap = build_pool(replace(cfg, league=replace(cfg.league, opponents=(entry,), focus=())),
+                            cfg.train.seed + 1000, battles=1)
+    snap.load(ppo.actor_arrays())
+    obs = pool.reset()
+    env = pool.envs[0]
+    env.start_recording(0)
+    while True:
+        joint, *_ = ppo.act(obs, explore=True)
+        st = pool.step(joint)
+        obs = st.obs
+        if st.rounds:
+            break
+    replay = env.stop_recording()
+    if replay is None:
+        raise RuntimeError("the replay of the trained tanks recorded nothing")
+    return write_replay(replay, out_dir, f"confront: {cfg.name}, {entry}")

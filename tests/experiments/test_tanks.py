@@ -108,6 +108,7 @@ def test_resume_after_a_kill_is_exact(tmp_path, overlap: str) -> None:
                                                               "ppo.overlap": overlap})
     full = train_run(cfg, tmp_path / "full", progress=False)
     part = new_run(cfg, tmp_path / "part")
+    part.release()  # the "killed" process's lock
     trainer = TankTrainer(cfg)
     while trainer.rounds_done < 6:
         trainer.update()

@@ -13,9 +13,8 @@ from typing import Any, cast
 import click
 
 from confront.checkpoint import CheckpointError
-from confront.cli import command
 from confront.config import ConfigError
-from confront.runs import Interrupted
+from confront.runs import Interrupted, command
 
 USER_ERRORS: tuple[type[BaseException], ...] = (ConfigError, CheckpointError, FileExistsError, FileNotFoundError,
                                                NotADirectoryError, IsADirectoryError)

@@ -8,8 +8,7 @@ from pathlib import Path
 
 import click
 
-from confront.cli import command
-from confront.runs import new_run_name
+from confront.runs import command, new_run_name
 from confront.train.spec import load_experiment
 
 

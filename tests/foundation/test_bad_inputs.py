@@ -148,7 +148,7 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
     ("resume with --init", ["train", "--resume", "{ws}/resumable", "--init", "{ws}/run"], "--init", None),
     ("init of a paper learner", ["train", "--init", "{ws}/run", "--out", "{ws}/new"], "train.init", "new"),
     ("init from a paper run", ["train", "-c", "tanks-engine", "--engine", "robocode", "--init", "{ws}/run", "--out",
-                               "{ws}/new"], "cannot be read", "new"),
+                               "{ws}/new"], "no trained PPO model", "new"),
     ("PPO engine training against a strafer", ["train", "-c", "tanks", "--engine", "robocode", "--out", "{ws}/new"],
      "'1v1:strafe'", "new"),
     ("resume an edited checkpoint", ["train", "--resume", "{ws}/edited", "--quiet"], "edited or corrupt", None),

@@ -269,6 +269,7 @@ class RumbleReport:
     stats: RunStats
     markdown: str
     out: Path
+    title: str = ""
 
 
 def opponents_of(folder: Path, candidate: Robot, mode: str) -> list[Robot]:
@@ -316,7 +317,12 @@ def run_rumble(candidate: str, folder: str | os.PathLike[str], settings: RumbleS
     write_json_atomic(out / "rumble.json", {"title": title, "settings": {**stored, "seeds": s.seeds},
                                             "rows": [asdict(r) for r in rows]})
     plot_rows(rows, title, out / "rumble.png")
-    return RumbleReport(rows, stats, markdown, out)
+    return RumbleReport(rows, stats, markdown, out, title)
+
+
+def default_workers() -> int:
+    """Local battles at once by default: the CPUs this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def rumble_cli(candidate: str, folder: Path, mode: str, seeds: int, rounds: int | None, field: str | None,
@@ -332,9 +338,7 @@ def rumble_cli(candidate: str, folder: Path, mode: str, seeds: int, rounds: int 
         if out is None:
             stem = Path(candidate).stem if candidate.endswith(".jar") or Path(candidate).is_dir() else candidate
             out = Path("rumbles") / (re.sub(r"[^\w.-]+", "_", stem) + f"-{mode}")
-        if workers is None:
-            workers = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        report = run_rumble(candidate, folder, settings, out, workers=workers or 1, address=address,
+        report = run_rumble(candidate, folder, settings, out, workers=workers or default_workers(), address=address,
                             progress=not quiet)
     except ValueError as err:
         raise click.UsageError(str(err)) from None

@@ -2,7 +2,7 @@
 (the exported TankBot, no Python) in the real engine, against the issue's targets.
 
     python -m confront.experiments.tank_report RUN [RUN ...] --out docs/results/tanks [--engine [--unseen]
-        [--engine-runs K]] [--compare WORK] [--play sampled|greedy]
+        [--engine-runs K]] [--compare WORK] [--play sampled|greedy] [--rumble FOLDER [--rumble-seeds N]]
 
 Each RUN is one training seed (``confront train -c tanks --set train.seed=K``). Per league entry: the greedy
 (or with ``--play sampled`` the sampling) simulator share (``--rounds`` rounds, the mean over runs with a
@@ -11,6 +11,11 @@ t-interval when there are 2 or more), and with ``--engine`` the exported robot's
 dodge, random moves: exported PolicyBots), for the first run or the first ``--engine-runs`` runs (then also
 the mean of their run means with a t-interval, and how many runs reach the target). Engine battles are kept
 per run (``<run>/eval/engine-<rounds>.json``), so runs can be played by separate processes side by side first.
+With ``--rumble FOLDER`` (repeatable) the first run's exported robot also plays a 1v1 rumble against every robot
+of a folder of robot jars (:mod:`confront.experiments.rumble`: ``--rumble-rounds`` rounds, 35 by default as the
+RoboRumble, on 800x600 x ``--rumble-seeds`` engine seeds), kept in ``<out>/rumble/<folder>-<play>/`` (resumable);
+``--results-from`` takes every other row from an earlier ``results.json`` of the same first run, so rumble rows can
+be added to a report whose other runs are gone.
 Writes ``report.md``, ``results.json`` and the learning curves (share against decisions and against wall
 time, per opponent).
 """
@@ -21,6 +26,7 @@ import argparse
 import json
 import math
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -136,16 +142,93 @@ def sim_shares(run: Path, cfg: Any, rounds: int, play: Play = "greedy") -> dict[
     return shares
 
 
+@dataclass(frozen=True)
+class ReportRumble:
+    """The report's rumbles: the first run's exported robot in 1v1 against every robot of each folder of robot jars,
+    ``rounds`` rounds on 800x600 x ``seeds`` engine seeds (0..seeds-1), ``workers`` battles at once (None: the
+    CPUs)."""
+
+    folders: tuple[Path, ...]
+    seeds: int = 2
+    rounds: int = 35  # the RoboRumble's
+    workers: int | None = None
+
+
 def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int, unseen: bool = False,
            compare_work: Path | None = None, engine_from: Path | None = None, engine_runs: int = 1,
-           play: Play = "greedy") -> dict[str, Any]:
+           play: Play = "greedy", rumble: ReportRumble | None = None,
+           results_from: Path | None = None) -> dict[str, Any]:
     """Evaluate the runs and write the report; return the results (``unseen``: also the first run's exported
     robot in the engine against :data:`UNSEEN`, robots no league entry names; ``compare_work``: also the
     comparison with the baselines, :mod:`confront.experiments.tank_compare`, trained and cached there;
     ``engine_from``: the engine rows of an earlier ``results.json`` of the same first run, instead of playing;
     ``engine_runs``: how many of the runs, from the first, play in the engine; ``play``: the policy's actions,
-    greedy or sampled, in the simulator and the exported robot)."""
+    greedy or sampled, in the simulator and the exported robot; ``rumble``: also the first run's rumbles;
+    ``results_from``: every row but the rumbles from an earlier ``results.json`` of the same first run, nothing
+    evaluated)."""
     out.mkdir(parents=True, exist_ok=True)
+    if results_from is not None:
+        result = earlier_results(results_from, runs[0], play)
+    else:
+        result = _evaluate(runs, out, rounds, engine, engine_seeds, unseen, compare_work, engine_from, engine_runs,
+                           play)
+    if rumble is not None:
+        played = play_rumbles(runs[0], out, rumble, play)
+        result["rumbles"] = [r for r in result.get("rumbles", []) if r["out"] not in {p["out"] for p in played}]
+        result["rumbles"] += played
+    (out / "results.json").write_text(json.dumps(result, indent=1))
+    _curves(runs, out)
+    write_markdown(result, out)
+    return result
+
+
+def _earlier_of(path: Path, run: Path) -> dict[str, Any]:
+    """An earlier report's results.json, checked to be of ``run`` as its first run: the same name, or the same
+    training (the summary's rounds and decisions; a run folder may be renamed when it is shipped)."""
+    earlier: dict[str, Any] = json.loads(path.read_text())
+    summary = json.loads((run / "summary.json").read_text())
+    trained = (earlier.get("trained") or [{}])[0]
+    if earlier["runs"][0] != run.name and not all(trained.get(k) == summary.get(k) for k in ("rounds", "decisions")):
+        raise ValueError(f"{path} is of run {earlier['runs'][0]}, not {run.name} (neither the name nor the training "
+                         "summary's rounds and decisions match)")
+    return earlier
+
+
+def earlier_results(path: Path, run: Path, play: Play) -> dict[str, Any]:
+    """An earlier report's results (every row as it was), checked to be of ``run`` playing ``play``."""
+    earlier = _earlier_of(path, run)
+    if earlier.get("play", "greedy") != play:
+        raise ValueError(f"{path} is of the {earlier.get('play', 'greedy')} policy: give --play "
+                         f"{earlier.get('play', 'greedy')}")
+    return earlier
+
+
+def play_rumbles(run: Path, out: Path, rumble: ReportRumble, play: Play) -> list[dict[str, Any]]:
+    """The run's exported robot (playing ``play``) in a 1v1 rumble against each folder
+    (:func:`confront.experiments.rumble.run_rumble`), kept in ``<out>/rumble/<folder>-<play>/`` so that its battles
+    are never played twice; per folder the rumble's title and table rows, as its ``rumble.json`` has them."""
+    import tempfile
+    from dataclasses import asdict
+
+    from confront.experiments.evaluate import run_jar
+    from confront.experiments.rumble import RumbleSettings, default_workers, run_rumble
+
+    settings = RumbleSettings("1v1", seeds=rumble.seeds, rounds=rumble.rounds)
+    played = []
+    with tempfile.TemporaryDirectory(prefix="confront-report-") as tmp:
+        jar = run_jar(run, Path(tmp), play)  # the same robot each time: a rerun resumes the stored battles
+        for folder in rumble.folders:
+            where = Path("rumble") / f"{folder.name}-{play}"
+            got = run_rumble(str(jar), folder, settings, out / where, workers=rumble.workers or default_workers(),
+                             progress=sys.stderr.isatty())
+            played.append({"folder": folder.name, "out": str(where), "title": got.title,
+                           "rows": [asdict(r) for r in got.rows]})
+    return played
+
+
+def _evaluate(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds: int, unseen: bool,
+              compare_work: Path | None, engine_from: Path | None, engine_runs: int, play: Play) -> dict[str, Any]:
+    """The simulator and engine rows of :func:`report` (and the comparison's files in ``out``)."""
     cfgs = [config_from_dict(load_toml(r / "config.toml")) for r in runs]
     entries = list(cfgs[0].league.opponents)
     sim: dict[str, list[float]] = {e: [] for e in entries}
@@ -168,13 +251,13 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
                     real_runs.setdefault(e, []).append([engine_share(run, pol, e, rounds, k + 1, cfgs[i])
                                                         for k in range(engine_seeds)])
         real = {e: v[0] for e, v in real_runs.items()}
-    unseen_rows = []
+    unseen_rows: list[dict[str, Any]] = []
+    earlier_rumbles: list[dict[str, Any]] = []
     if engine_from is not None:
-        earlier = json.loads(engine_from.read_text())
-        if earlier["runs"][0] != runs[0].name:
-            raise ValueError(f"{engine_from} is of run {earlier['runs'][0]}, not {runs[0].name}")
+        earlier = _earlier_of(engine_from, runs[0])
         real = {r["entry"]: r["engine"] for r in earlier["rows"] if r.get("engine")}
         unseen_rows = earlier.get("unseen", [])
+        earlier_rumbles = earlier.get("rumbles", [])
         engine_seeds = earlier["engine_seeds"]
     if engine and unseen:
         for e in UNSEEN:
@@ -187,15 +270,12 @@ def report(runs: list[Path], out: Path, rounds: int, engine: bool, engine_seeds:
               "engine_runs": [r.name for r in runs[:engine_runs]] if engine else [],
               "rows": [{"entry": e, "sim": sim[e], "engine": real.get(e), "engine_runs": real_runs.get(e),
                         "target": target_of(e)} for e in entries],
-              "unseen": unseen_rows}
+              "unseen": unseen_rows, "rumbles": earlier_rumbles}
     if compare_work is not None:
         from confront.experiments.tank_compare import compare, compare_entries
 
         compare(runs, out, rounds, compare_work, ours={e: sim[e] for e in compare_entries(tuple(entries))},
                 play=play)
-    (out / "results.json").write_text(json.dumps(result, indent=1))
-    _curves(runs, out)
-    write_markdown(result, out)
     return result
 
 
@@ -258,6 +338,8 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
                   "| opponent | engine (battles) | engine mean |", "|---|---:|---:|"]
         lines += [f"| {u['entry']} | {' / '.join(f'{v:.3f}' for v in u['engine'])} | {np.mean(u['engine']):.3f} |"
                   for u in result["unseen"]]
+    for rum in result.get("rumbles", []):
+        lines += ["", *_rumble_lines(rum)]
     if (out / "compare.md").is_file():
         lines += ["", "Against the paper's method, SB3 PPO and random moves over training seeds, with one-sided tests: "
                   "[compare.md](compare.md) (`python -m confront.experiments.tank_compare`)."]
@@ -266,6 +348,16 @@ def write_markdown(result: dict[str, Any], out: Path) -> Path:
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _rumble_lines(rum: dict[str, Any]) -> list[str]:
+    """A rumble's section of report.md: the rumble's own Markdown table (``rumble.md``) of its stored rows."""
+    from confront.experiments.rumble import RumbleRow, to_markdown
+
+    rows = [RumbleRow(**r) for r in rum["rows"]]
+    return [f"Rumble against the robots of `{rum['folder']}` (the first run's exported robot, as `confront rumble` "
+            f"plays it; battles and files in [{rum['out']}/]({rum['out']}/rumble.md)):", "",
+            *to_markdown(rows, rum["title"]).rstrip("\n").splitlines()]
 
 
 def main() -> None:
@@ -285,7 +377,26 @@ def main() -> None:
     ap.add_argument("--play", choices=("sampled", "greedy"), default="sampled",
                     help="the policy's actions in the simulator and the exported robot: drawn from each head's "
                          "softmax as `confront export` plays (default), or each head's maximum")
+    ap.add_argument("--rumble", type=Path, action="append", default=[], metavar="FOLDER",
+                    help="also a 1v1 rumble of the first run's exported robot against every robot jar in FOLDER "
+                         "(repeatable; kept in OUT/rumble/<folder>-<play>/, resumable)")
+    ap.add_argument("--rumble-seeds", type=int, default=2, help="with --rumble: battles per opponent (default 2)")
+    ap.add_argument("--rumble-rounds", type=int, default=35, help="with --rumble: rounds per battle (default 35)")
+    ap.add_argument("--workers", type=int, default=None, help="with --rumble: battles at once (default: the CPUs)")
+    ap.add_argument("--results-from", type=Path, default=None, metavar="RESULTS_JSON",
+                    help="every row but the rumbles from an earlier results.json of the same first run (nothing "
+                         "evaluated; to add rumbles to a report whose other runs are gone)")
     args = ap.parse_args()
+    if args.rumble_seeds < 1 or args.rumble_rounds < 1 or (args.workers is not None and args.workers < 1):
+        ap.error("--rumble-seeds, --rumble-rounds and --workers must be at least 1")
+    for f in args.rumble:
+        if not f.is_dir():
+            ap.error(f"--rumble {f}: no such folder")
+    if len({f.name for f in args.rumble}) < len(args.rumble):
+        ap.error("--rumble folders must have different names (each keeps its battles in OUT/rumble/<name>-<play>/)")
+    if args.results_from is not None and (args.engine or args.engine_from or args.compare or len(args.runs) > 1):
+        ap.error("--results-from takes every row from an earlier report: give one run, without --engine, "
+                 "--engine-from or --compare")
     if args.rounds < 1 or args.engine_seeds < 1 or not 1 <= args.engine_runs <= len(args.runs):
         ap.error("--rounds and --engine-seeds must be at least 1, --engine-runs between 1 and the number of runs")
     if args.engine_from is not None and args.engine:
@@ -293,8 +404,13 @@ def main() -> None:
     for r in args.runs:
         if not (r / "config.toml").is_file() or not (r / "model" / "model.json").is_file():
             ap.error(f"{r} is not a trained run folder (config.toml and model/model.json)")
-    res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds, args.unseen, args.compare,
-                 args.engine_from, args.engine_runs, args.play)
+    rumble = (ReportRumble(tuple(args.rumble), args.rumble_seeds, args.rumble_rounds, args.workers)
+              if args.rumble else None)
+    try:
+        res = report(args.runs, args.out, args.rounds, args.engine, args.engine_seeds, args.unseen, args.compare,
+                     args.engine_from, args.engine_runs, args.play, rumble, args.results_from)
+    except (ValueError, FileNotFoundError) as err:  # bad input found on the way: one line, exit 2
+        ap.error(str(err))
     print((args.out / "report.md").read_text())
     print(json.dumps({"report": str(args.out / "report.md"), "entries": len(res["rows"])}))
 

@@ -150,3 +150,57 @@ def test_teams_and_melee(folder: Path, tmp_path: Path, mode: str) -> None:
             assert mode == "teams" or theirs["name"] == opp
             assert rows[opp]["aps"] == pytest.approx(ours["total"] / (ours["total"] + theirs["total"]))
             assert rows[opp]["survival_pct"] == pytest.approx(100 * ours["firsts"] / 2)
+
+
+def test_tank_report_rumble_rows_are_the_rumbles_table(folder: Path, tmp_path: Path) -> None:
+    """tank_report --rumble: the report's rows (results.json and report.md) are the rumble's own table, each APS
+    the stored battle's share; a second report plays no battle, and `confront rumble` on its folder gives the same
+    table."""
+    import shutil
+
+    from confront.experiments.tank_report import ReportRumble, report
+
+    two = tmp_path / "robots"
+    two.mkdir()
+    for name in SAMPLES:
+        shutil.copy(folder / f"sample.{name}_1.0.jar", two)
+    run = tmp_path / "seed0"  # the shipped run under another name: the earlier report is found by its training
+    shutil.copytree(REPO / "docs" / "results" / "tanks" / "run", run)
+    summary = json.loads((run / "summary.json").read_text())
+    earlier = tmp_path / "earlier.json"
+    earlier.write_text(json.dumps({"runs": ["seed0x"], "rounds": 10, "play": "sampled", "engine_seeds": 1,
+                                   "trained": [{k: summary[k] for k in ("rounds", "wall_time_s", "decisions")}],
+                                   "engine_runs": [], "unseen": [],
+                                   "rows": [{"entry": "1v1:Walls", "sim": [0.9], "engine": [0.91],
+                                             "engine_runs": None, "target": 0.9}]}))
+    out = tmp_path / "report"
+    res = report([run], out, 10, False, 1, play="sampled", rumble=ReportRumble((two,), seeds=1, rounds=2, workers=2),
+                 results_from=earlier)
+    own = out / "rumble" / "robots-sampled"
+    table = json.loads((own / "rumble.json").read_text())
+    [rum] = res["rumbles"]
+    assert rum["title"] == table["title"] == ("confront.TankBot 1.0 (1v1), 2 rounds on 800x600 x 1 seed(s), "
+                                              "CPU constant 10 ms")
+    assert json.dumps(rum["rows"]) == json.dumps(table["rows"])  # NaN intervals (one seed) included
+    assert json.dumps(json.loads((out / "results.json").read_text())["rumbles"]) == json.dumps(res["rumbles"])
+    md, own_md = (out / "report.md").read_text(), (own / "rumble.md").read_text()
+    assert own_md.rstrip("\n") in md and "| 1v1:Walls |" in md
+    rows = {r["opponent"]: r for r in rum["rows"]}
+    assert sorted(rows) == ["sample.Crazy 1.0", "sample.SpinBot 1.0"]
+    for name, row in rows.items():
+        battle = json.loads((own / "battles" / f"1v1-{name.replace(' ', '_')}-s0.json").read_text())
+        ours, theirs = battle["contestants"]
+        assert ours["name"] == "confront.TankBot 1.0" and theirs["name"] == name
+        assert row["status"] == "ok" and row["battles"] == 1
+        assert row["aps"] == pytest.approx(ours["total"] / (ours["total"] + theirs["total"]))
+        assert row["survival_pct"] == pytest.approx(100 * ours["firsts"] / 2)
+    stamps = {p.name: p.stat().st_mtime_ns for p in (own / "battles").glob("*.json")}
+    again = report([run], out, 10, False, 1, play="sampled", rumble=ReportRumble((two,), seeds=1, rounds=2),
+                   results_from=out / "results.json")
+    assert json.dumps(again["rumbles"]) == json.dumps(res["rumbles"])
+    assert {p.name: p.stat().st_mtime_ns for p in (own / "battles").glob("*.json")} == stamps
+    cli_run = CliRunner().invoke(cli, ["rumble", str(run), str(two), "--seeds", "1", "--rounds", "2",
+                                       "--out", str(own), "--quiet"])
+    assert cli_run.exit_code == 0, cli_run.output
+    assert "0 battle(s) played, 2 already done" in cli_run.output
+    assert own_md in cli_run.output  # the table the report holds, as the command prints it

@@ -473,3 +473,32 @@ def test_report_end_to_end_from_a_trained_run(tmp_path) -> None:
     bad = subprocess.run([sys.executable, "-m", "confront.experiments.tank_report", str(tmp_path), "--out",
                           str(tmp_path / "o4")], capture_output=True, text=True)
     assert bad.returncode == 2 and "is not a trained run folder" in bad.stderr
+
+
+def test_report_rows_from_an_earlier_report_of_the_same_training(tmp_path, monkeypatch, capsys) -> None:
+    """--results-from: an earlier results.json is the run's when the name or the training summary matches; its
+    play must be the report's; the rumble options refuse bad input with one line (exit 2)."""
+    from confront.experiments.tank_report import earlier_results, main
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "summary.json").write_text(json.dumps({"rounds": 120, "decisions": 4000, "wall_time_s": 3.0}))
+    earlier = tmp_path / "results.json"
+    base = {"runs": ["seed0"], "play": "sampled", "rows": [], "trained": [{"rounds": 120, "decisions": 4000}]}
+    earlier.write_text(json.dumps(base))
+    assert earlier_results(earlier, run, "sampled") == base  # renamed, the same training
+    with pytest.raises(ValueError, match="of the sampled policy: give --play sampled"):
+        earlier_results(earlier, run, "greedy")
+    earlier.write_text(json.dumps({**base, "trained": [{"rounds": 120, "decisions": 4001}]}))
+    with pytest.raises(ValueError, match="is of run seed0, not run"):
+        earlier_results(earlier, run, "sampled")
+    (run / "config.toml").write_text("")
+    (run / "model").mkdir()
+    (run / "model" / "model.json").write_text("{}")
+    for extra, words in ((["--rumble", str(tmp_path / "nowhere")], "no such folder"),
+                         (["--rumble", str(tmp_path), "--rumble-seeds", "0"], "must be at least 1"),
+                         (["--results-from", str(earlier), "--engine"], "give one run, without --engine")):
+        monkeypatch.setattr("sys.argv", ["tank_report", str(run), "--out", str(tmp_path / "o"), *extra])
+        with pytest.raises(SystemExit) as exc:
+            main()
+        assert exc.value.code == 2 and words in capsys.readouterr().err

@@ -9,6 +9,9 @@ battles). Team 0's learning tanks of every battle of every entry are the pool's 
 (N, F) float32 (after auto-reset, a new round's first), per-step rewards (N,) (the sum of the step's per-turn
 rewards), ``done`` (N,) (the tank died or its round ended: nothing to bootstrap), ``active`` (N,) (it was
 alive at the start of the step: the transition counts), and the rounds that ended (entry, score ours/theirs).
+``step(actions, playing)`` with ``playing`` (entries,) bools steps only those entries: the others' battles wait
+where they are (their agents' observations unchanged, reward 0, not done, not active), e.g. for prioritised
+sampling of the entries a learner still loses to.
 
 Opponents driven by the caller (``"td"`` in a scenario's opponents: a TD team, random moves, a dodge, a
 snapshot of the policy) get their actions from the entry's ``policy(discrete (n,), features (n, F), rng)``.
@@ -111,15 +114,20 @@ class PoolEnv:
     def _gather(self, feats: list[np.ndarray]) -> np.ndarray:
         return np.concatenate([f[:, o].reshape(-1, f.shape[-1]) for f, o in zip(feats, self.ours, strict=True)])
 
-    def step(self, actions: np.ndarray) -> PoolStep:
-        """Every env one SMDP step with the agents' ``actions`` (N,).
+    def step(self, actions: np.ndarray, playing: np.ndarray | None = None) -> PoolStep:
+        """Every env (or the ``playing`` entries' only) one SMDP step with the agents' ``actions`` (N,).
 
         The entries' compiled kernels run together, largest first, on this thread and the pool's others."""
         a = np.asarray(actions, dtype=np.int64)
         if a.shape != (self.n_agents,):
             raise ValueError(f"actions must have shape ({self.n_agents},), got {a.shape}")
+        play = np.ones(len(self.envs), dtype=bool) if playing is None else np.asarray(playing, dtype=bool)
+        if play.shape != (len(self.envs),):
+            raise ValueError(f"playing must have shape ({len(self.envs)},), got {play.shape}")
+        on = np.flatnonzero(play)
         full_actions = []
-        for k, (entry, env) in enumerate(zip(self.entries, self.envs, strict=True)):
+        for k in on:
+            entry, env = self.entries[k], self.envs[k]
             ours, theirs = self.ours[k], self.theirs[k]
             full = np.zeros((env.n_battles, env.n_robots), dtype=np.int64)
             full[:, ours] = a[self.bounds[k]:self.bounds[k + 1]].reshape(env.n_battles, -1)
@@ -128,14 +136,26 @@ class PoolEnv:
                 full[:, theirs] = np.asarray(entry.policy(d.reshape(-1), f.reshape(-1, f.shape[-1]), self.rng),
                                              dtype=np.int64).reshape(env.n_battles, -1)
             full_actions.append(full)
-        if any(env.recording is not None for env in self.envs):
-            results = [env.step(full) for env, full in zip(self.envs, full_actions, strict=True)]
+        envs = [self.envs[k] for k in on]
+        if any(env.recording is not None for env in envs):
+            stepped = [env.step(full) for env, full in zip(envs, full_actions, strict=True)]
         else:
-            results = self._step_together(full_actions)
+            stepped = self._step_together(envs, full_actions)
+        results: list[StepResult | None] = [None] * len(self.envs)
+        for k, res in zip(on, stepped, strict=True):
+            results[k] = res
         obs, rew, done, active = [], [], [], []
         rounds: list[dict[str, float | str | bool]] = []
         for k, (entry, res) in enumerate(zip(self.entries, results, strict=True)):
             ours = self.ours[k]
+            if res is None:  # waiting: as it was, no transition
+                f = self._feats[k]
+                n = int(self.bounds[k + 1] - self.bounds[k])
+                obs.append(f[:, ours].reshape(-1, f.shape[-1]))
+                rew.append(np.zeros(n))
+                done.append(np.zeros(n, dtype=bool))
+                active.append(np.zeros(n, dtype=bool))
+                continue
             self._disc[k], self._feats[k] = res.discrete, res.features
             obs.append(res.features[:, ours].reshape(-1, res.features.shape[-1]))
             rew.append(res.rewards[:, ours].sum(axis=2).reshape(-1))
@@ -152,18 +172,19 @@ class PoolEnv:
         return PoolStep(np.concatenate(obs), np.concatenate(rew), np.concatenate(done), np.concatenate(active),
                         rounds)
 
-    def _step_together(self, full_actions: list[np.ndarray]) -> list[StepResult]:
-        """Every env's step (what ``env.step`` does) with all the kernels run together, largest first."""
-        begun = [env.begin_step(full) for env, full in zip(self.envs, full_actions, strict=True)]
+    @staticmethod
+    def _step_together(envs: list[TeamBattleEnv], full_actions: list[np.ndarray]) -> list[StepResult]:
+        """The envs' steps (what ``env.step`` does) with all the kernels run together, largest first."""
+        begun = [env.begin_step(full) for env, full in zip(envs, full_actions, strict=True)]
         workers = kernel_pool()._max_workers
-        whole = len(self.envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
+        whole = len(envs) >= 2 * workers  # enough entries to balance the threads: one call per entry
         calls: list[tuple[int, tuple[Any, ...]]] = []
-        for k, (env, (rewards, _, obs)) in enumerate(zip(self.envs, begun, strict=True)):
+        for k, (env, (rewards, _, obs)) in enumerate(zip(envs, begun, strict=True)):
             calls.extend((k, c) for c in env.kernel_calls(0, env.turns_per_step, rewards, obs, whole=whole))
-        calls.sort(key=lambda kc: -(kc[1][1] - kc[1][0]) * self.envs[kc[0]].n_robots)  # largest first
-        run_parallel(kernel_pool(), call_kernel, [(self.envs[k].kernel(c), c) for k, c in calls], workers)
+        calls.sort(key=lambda kc: -(kc[1][1] - kc[1][0]) * envs[kc[0]].n_robots)  # largest first
+        run_parallel(kernel_pool(), call_kernel, [(envs[k].kernel(c), c) for k, c in calls], workers)
         return [env.finish_step(rewards, active, obs)
-                for env, (rewards, active, obs) in zip(self.envs, begun, strict=True)]
+                for env, (rewards, active, obs) in zip(envs, begun, strict=True)]
 
     def state_dict(self) -> dict[str, np.ndarray]:
         """Every env's state and the last observations (data only)."""

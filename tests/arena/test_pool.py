@@ -68,3 +68,36 @@ def test_pool_computes_observations_only_for_those_read() -> None:
     for env, disc in zip(pool.envs, pool._disc, strict=True):  # paper observations only for the opponents' policies
         assert (env.paper_robots == (env.learner & (env.team_ids() != 0))).all()
         assert not disc[:, ~env.paper_robots].any()
+
+
+def test_waiting_entries_keep_their_battles_and_give_no_transitions() -> None:
+    """An entry that does not play waits where it is: its agents' observations do not change, their reward is 0 and
+    inactive; when it plays again it goes on as if the waiting steps had not been (= an env stepped only then)."""
+    entries = [PoolEntry("1v1/SpinBot", "1v1", "SpinBot", 3), PoolEntry("4v4/Walls", "4v4", "Walls", 2)]
+    pool = PoolEnv(entries, CONFIG, seed=5)
+    alone = TeamBattleEnv("4v4", n_battles=2, seed=5 * 1000 + 1, opponents="Walls", config=CONFIG)
+    obs = pool.reset()
+    alone.reset()
+    ours = alone.team_ids() == 0
+    rng = np.random.default_rng(1)
+    lo, hi = int(pool.bounds[1]), int(pool.bounds[2])
+    played = 0
+    for step in range(40):
+        a = rng.integers(0, int(np.prod(pool.action_dims)), size=pool.n_agents)
+        playing = np.array([True, step % 3 == 0])
+        st = pool.step(a, playing)
+        if playing[1]:
+            full = np.zeros((2, alone.n_robots), dtype=np.int64)
+            full[:, ours] = a[lo:hi].reshape(2, -1)
+            res = alone.step(full)
+            np.testing.assert_array_equal(st.obs[lo:hi], res.features[:, ours].reshape(-1, pool.n_features))
+            played += 1
+        else:
+            np.testing.assert_array_equal(st.obs[lo:hi], obs[lo:hi])
+            assert not st.active[lo:hi].any() and not st.reward[lo:hi].any() and not st.done[lo:hi].any()
+            assert all(r["opponent"] == "1v1/SpinBot" for r in st.rounds)
+        assert st.active[:lo].any()
+        obs = st.obs
+    assert played == 14
+    with pytest.raises(ValueError, match="playing must have shape"):
+        pool.step(np.zeros(pool.n_agents, dtype=np.int64), np.array([True]))

@@ -18,7 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
@@ -44,7 +44,8 @@ if TYPE_CHECKING:
     from confront.engine.export import ExportedPolicy
 
 __all__ = ["td_learner", "td_team", "td_policy", "random_policy", "dodge_policy", "strafe_policy", "SnapshotPolicy",
-           "PAPER_MOVE_OPPONENTS", "paper_move_values", "paper_move_robot", "build_pool"]
+           "PAPER_MOVE_OPPONENTS", "paper_move_values", "paper_move_robot", "build_pool", "recent_shares",
+           "pfsp_playing"]
 
 
 # -- the paper's TD team -----------------------------------------------------------------------------------------
@@ -232,3 +233,35 @@ def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, pro
         else:
             entries.append(PoolEntry(e, scen, opp, n))
     return PoolEnv(entries, smdp_tank_config(cfg), seed=seed), snap
+
+
+# -- prioritised sampling ----------------------------------------------------------------------------------------
+
+def recent_shares(rows: list[dict[str, Any]], names: list[str], window: int) -> np.ndarray:
+    """Each entry's mean share over its last ``window`` rounds in ``rows`` (0.5 before its first)."""
+    out = np.full(len(names), 0.5)
+    index = {n: k for k, n in enumerate(names)}
+    seen: list[list[float]] = [[] for _ in names]
+    for r in reversed(rows):
+        k = index.get(str(r["opponent"]))
+        if k is not None and len(seen[k]) < window:
+            seen[k].append(float(r["share"]))
+        if all(len(v) >= window for v in seen):
+            break
+    for k, v in enumerate(seen):
+        if v:
+            out[k] = float(np.mean(v))
+    return out
+
+
+def pfsp_playing(shares: np.ndarray, rng: np.random.Generator, fraction: float, floor: float, power: float
+                 ) -> np.ndarray:
+    """Which entries play the next rollout (bools): entry e with probability p_e = clip(fraction * E * w_e / sum w,
+    floor, 1), w_e = (1 - share_e)^power (prioritised fictitious self-play's f_hard, Vinyals et al. 2019; all won:
+    p_e = fraction); when none is drawn, one plays, drawn by p."""
+    w = (1.0 - np.clip(shares, 0.0, 1.0)) ** power
+    p = np.clip(fraction * len(w) * w / w.sum(), floor, 1.0) if w.sum() > 0 else np.full(len(w), fraction)
+    play = rng.random(len(w)) < p
+    if not play.any():
+        play[int(rng.choice(len(p), p=p / p.sum()))] = True
+    return play

@@ -25,7 +25,7 @@ from confront.arena.pool import PoolStep
 from confront.arena.tank import FEATURE_NAMES
 from confront.learning.ppo import PPO, UPDATE_STATS, Rollout
 from confront.runs import Run
-from confront.train.league import build_pool
+from confront.train.league import build_pool, pfsp_playing, recent_shares
 from confront.train.loop import share_by_opponent
 from confront.train.ppo_model import save_tank_model
 from confront.train.spec import ExperimentConfig
@@ -109,6 +109,16 @@ class TankTrainer:
         self.updates.append(row)
         return row
 
+    def _playing(self) -> np.ndarray | None:
+        """The entries that play the next rollout: all, or with ``league.prioritise`` those that
+        :func:`~confront.train.league.pfsp_playing` draws from their recent shares."""
+        lc = self.cfg.league
+        if not lc.prioritise:
+            return None
+        names = [e.name for e in self.pool.entries]
+        shares = recent_shares(self.rows, names, lc.share_window)
+        return pfsp_playing(shares, self.pool.rng, lc.play_fraction, lc.play_floor, lc.pfsp_power)
+
     def _collect(self) -> tuple[Rollout, float]:
         """S steps of every battle with the acting policy: the rollout, and the seconds spent in the env."""
         c, pool = self.ppo.config, self.pool
@@ -120,10 +130,11 @@ class TankTrainer:
                       value=np.zeros((s, n), np.float32), reward=np.zeros((s, n)), done=np.zeros((s, n), bool),
                       active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
         t_env = 0.0
+        playing = self._playing()
         for k in range(s):
             joint, heads, logp = self.ppo.act(self.obs)
             te = time.perf_counter()
-            st: PoolStep = pool.step(joint)
+            st: PoolStep = pool.step(joint, playing)
             t_env += time.perf_counter() - te
             buf.obs[k], buf.critic[k], buf.heads[k], buf.logp[k] = self.obs, crit, heads, logp
             buf.reward[k], buf.done[k], buf.active[k] = st.reward * c.reward_scale, st.done, st.active

@@ -161,6 +161,15 @@ class LeagueSection:
     focus_weight: int = field(3, ge=1, le=64, doc="battle multiplier of the focus entries")
     snapshot_every: int = field(20, ge=1, doc="updates between self-play snapshots")
     snapshots: int = field(5, ge=1, le=100, doc="snapshots kept; self-play battles sample one per update")
+    prioritise: bool = field(False, doc="prioritised sampling: each rollout only some entries play, each with "
+                             "probability growing as (1 - its recent share)^pfsp_power (AlphaStar's PFSP), so the "
+                             "battles go to what the policy still loses to")
+    play_fraction: float = field(0.5, gt=0.0, le=1.0, doc="with prioritise: entries playing a rollout, on average")
+    play_floor: float = field(0.1, gt=0.0, le=1.0, doc="with prioritise: every entry's least chance to play a "
+                              "rollout (nothing is forgotten)")
+    pfsp_power: float = field(2.0, ge=0.0, le=10.0, doc="with prioritise: the weight's exponent (0 = uniform)")
+    share_window: int = field(100, ge=1, le=100000, doc="with prioritise: an entry's recent share is over its "
+                              "last share_window rounds (0.5 before any)")
 
     def __post_init__(self) -> None:
         from confront.arena.scenarios import get_scenario, opponent_members, scenario_names

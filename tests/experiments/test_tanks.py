@@ -102,10 +102,11 @@ def test_training_against_sittingduck_learns(tmp_path, overlap: str) -> None:
     assert before["win_rate"] <= after["win_rate"]
 
 
-@pytest.mark.parametrize("overlap", ["false", "true"])
-def test_resume_after_a_kill_is_exact(tmp_path, overlap: str) -> None:
+@pytest.mark.parametrize(("overlap", "prioritise"), [("false", "false"), ("true", "false"), ("false", "true")])
+def test_resume_after_a_kill_is_exact(tmp_path, overlap: str, prioritise: str) -> None:
     cfg = _cfg(tmp_path, "1v1:SpinBot,4v4:dodge", ckpt="6", **{"league.battles": "2", "train.rounds": "14",
-                                                              "ppo.overlap": overlap})
+                                                              "ppo.overlap": overlap,
+                                                              "league.prioritise": prioritise})
     full = train_run(cfg, tmp_path / "full", progress=False)
     part = new_run(cfg, tmp_path / "part")
     part.release()  # the "killed" process's lock
@@ -502,3 +503,43 @@ def test_report_rows_from_an_earlier_report_of_the_same_training(tmp_path, monke
         with pytest.raises(SystemExit) as exc:
             main()
         assert exc.value.code == 2 and words in capsys.readouterr().err
+
+
+def test_pfsp_probabilities_hand_computed() -> None:
+    from confront.train.league import pfsp_playing
+
+    # shares 1, 0.5, 0: w = 0, 0.25, 1 (power 2); p = clip(0.5 * 3 * w / 1.25, 0.1, 1) = 0.1, 0.3, 1
+    rng = np.random.default_rng(0)
+    draws = np.array([pfsp_playing(np.array([1.0, 0.5, 0.0]), rng, 0.5, 0.1, 2.0) for _ in range(20000)])
+    np.testing.assert_allclose(draws.mean(axis=0), [0.1, 0.3, 1.0], atol=0.01)
+    # power 0: uniform, each with the fraction's chance, plus a third of P(none) = 1/8 (one is drawn then)
+    uniform = np.array([pfsp_playing(np.array([1.0, 0.5, 0.0]), rng, 0.5, 0.1, 0.0) for _ in range(20000)])
+    np.testing.assert_allclose(uniform.mean(axis=0), [0.5 + 0.125 / 3] * 3, atol=0.015)
+    # all won: uniform at the fraction, and never none
+    won = np.array([pfsp_playing(np.ones(4), rng, 0.5, 0.1, 2.0) for _ in range(4000)])
+    assert won.sum(axis=1).min() == 1 and won.mean() == pytest.approx(0.5 + 0.0625 / 4, abs=0.02)
+
+
+def test_recent_shares_over_each_entrys_last_rounds() -> None:
+    from confront.train.league import recent_shares
+
+    rows = [{"opponent": "a", "share": s} for s in (0.0, 1.0, 0.2, 0.4)] + [{"opponent": "b", "share": 0.9}]
+    np.testing.assert_allclose(recent_shares(rows, ["a", "b", "c"], 2), [0.3, 0.9, 0.5])
+    np.testing.assert_allclose(recent_shares(rows, ["a"], 10), [0.4])
+
+
+def test_prioritised_league_plays_more_of_what_it_loses(tmp_path) -> None:
+    """With prioritise, the entry the untrained policy loses to (4v4 Walls) gets more rounds than the sitting duck
+    it beats from the start; without, the duck's short rounds are the most."""
+    def rounds_of(prioritise: str) -> dict[str, int]:
+        cfg = _cfg(tmp_path, "1v1:SittingDuck,4v4:Walls", **{"league.battles": "4", "train.rounds": "400",
+                                                             "league.prioritise": prioritise,
+                                                             "league.play_floor": "0.1"})
+        trainer = TankTrainer(cfg)
+        while trainer.rounds_done < 400:
+            trainer.update()
+        return {e: sum(r["opponent"] == e for r in trainer.rows) for e in ("1v1:SittingDuck", "4v4:Walls")}
+
+    plain, pfsp = rounds_of("false"), rounds_of("true")
+    assert plain["1v1:SittingDuck"] > plain["4v4:Walls"]
+    assert pfsp["4v4:Walls"] / pfsp["1v1:SittingDuck"] > 2 * plain["4v4:Walls"] / plain["1v1:SittingDuck"]

@@ -124,7 +124,7 @@ class PoolEnv:
         play = np.ones(len(self.envs), dtype=bool) if playing is None else np.asarray(playing, dtype=bool)
         if play.shape != (len(self.envs),):
             raise ValueError(f"playing must have shape ({len(self.envs)},), got {play.shape}")
-        on = np.flatnonzero(play)
+        on = [int(k) for k in np.flatnonzero(play)]
         full_actions = []
         for k in on:
             entry, env = self.entries[k], self.envs[k]
@@ -142,8 +142,8 @@ class PoolEnv:
         else:
             stepped = self._step_together(envs, full_actions)
         results: list[StepResult | None] = [None] * len(self.envs)
-        for k, res in zip(on, stepped, strict=True):
-            results[k] = res
+        for j, done_step in zip(on, stepped, strict=True):
+            results[j] = done_step
         obs, rew, done, active = [], [], [], []
         rounds: list[dict[str, float | str | bool]] = []
         for k, (entry, res) in enumerate(zip(self.entries, results, strict=True)):

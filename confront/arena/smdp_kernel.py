@@ -4,8 +4,9 @@ observations (``smdp_turns``).
 
 ``smdp_turns`` takes the arena's bundles (:mod:`confront.arena.state`'s robots, battles, bullets, radar, scores;
 :mod:`confront.arena.kernels`' settings and scratch), the scripted robots' :class:`~confront.arena.bots.BotState`,
-the technique robots' :class:`~confront.arena.tech.TechState` and four of its own: :class:`Tanks` (the learning tanks' step), :class:`Senses` (what the robots know),
-:class:`Outputs` (what the step writes) and :class:`Views` (which observations, of what size).
+the technique robots' :class:`~confront.arena.tech.TechState` and four of its own: :class:`Tanks` (the learning
+tanks' step), :class:`Senses` (what the robots know), :class:`Outputs` (what the step writes) and :class:`Views`
+(which observations, of what size).
 
 A module of its own so that the Python side of the env (smdp.py) can change without recompiling the kernel;
 its numba cache is stamped with all kernel modules' sources (kernel_cache.py), as it holds their code.
@@ -160,19 +161,19 @@ def smdp_turns(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, set
                has_tech, tanks, senses, out, views):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
-    per the action table's lead column), scripted bots, technique robots (``has_tech``), one Robocode turn, rewards (Eq. 35, or the change of
-    the team's score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
-    disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0, of the robots in
-    ``view_mask`` (R,); the others' rows zero, their slots -1; the paper's observations of the robots in
-    ``paper_mask`` (R,), the others' target -1, state and features 0). Returns the turn index
-    where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
+    per the action table's lead column), scripted bots, technique robots (``has_tech``), one Robocode turn,
+    rewards (Eq. 35, or the change of the team's score margin with ``ctrl[C_REWARD]``). Then the observations of
+    those battles' robots into target, disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0,
+    of the robots in ``view_mask`` (R,); the others' rows zero, their slots -1; the paper's observations of the
+    robots in ``paper_mask`` (R,), the others' target -1, state and features 0). Returns the turn index where it
+    stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
     run in parallel threads. Each robot picks its target and aims from its own picture
     (observe.perceive_row); after each turn the robots' scans go into ``memory``. The battles are stepped in
     groups of ``group`` (TeamBattleEnv.battle_group); the results do not depend on it."""
     n = robots.f.shape[2]
     return _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots,
-                      tech, has_tech, tanks, senses, out, views, np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_),
-                      np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]),
+                      tech, has_tech, tanks, senses, out, views, np.empty(n), np.empty(n), np.empty(n),
+                      np.empty(n, dtype=np.bool_), np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]),
                       np.zeros(out.tank_view.shape[2]), np.empty(n),
                       np.empty(-(-(b1 - b0) // views.group), dtype=np.int64))
 

@@ -763,30 +763,6 @@ def tech_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 1
 
 
 class _Driver(Protocol):
-    def new_battles(self, mask: np.ndarray) -> None:
-        """The masked battles (B,) started a new battle (``Arena.new_battle``): forget all their memory now."""
-        self._round[np.asarray(mask, dtype=bool)] = -1
-        self.sync_rounds()
-
-    def kernel_state(self) -> TechState:
-        """The robots' arrays for a compiled turn loop (:func:`tech_battle_step`), with their own hit scratch (one
-        per thread)."""
-        return TechState(self.guns, self.moves, self.mem, self.stat, self.rng, self.mates, np.zeros(MAX_HITS),
-                         np.zeros(MAX_HITS))
-
-    def state_dict(self) -> dict[str, np.ndarray]:
-        """The robots' memory (per round, per battle), generators and the round each battle's memory is of."""
-        return {"mem": self.mem.copy(), "stat": self.stat.copy(), "rng": self.rng.copy(), "round": self._round.copy()}
-
-    def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
-        """Restore what :meth:`state_dict` wrote."""
-        for name, arr in (("mem", self.mem), ("stat", self.stat), ("rng", self.rng), ("round", self._round)):
-            saved = d.get(name)
-            if saved is None or np.shape(saved) != arr.shape:
-                got = "missing" if saved is None else f"shape {np.shape(saved)}"
-                raise ValueError(f"technique robots' {name} is {got}, expected shape {arr.shape}")
-            arr[...] = saved
-
     def commands(self, cmd: np.ndarray) -> np.ndarray: ...
 
 

@@ -26,7 +26,8 @@ def test_the_technique_robot_names_agree_everywhere() -> None:
 def test_paper_trainer_against_surfgf_teams() -> None:
     """``opponent.kind = "SurfGF"``: the demo's 4 DMNN tanks against 4 SurfGF; a few rounds, the SurfGFs fire and
     score."""
-    cfg = load_experiment("demo", ["opponent.kind=SurfGF", "arena.battles=2", "train.rounds=4", "train.session_rounds=4"])
+    cfg = load_experiment("demo", ["opponent.kind=SurfGF", "arena.battles=2", "train.rounds=4",
+                                   "train.session_rounds=4"])
     assert cfg.opponent.kind == "SurfGF"
     trainer = SMDPTrainer.from_config(cfg)
     env = trainer.loop.env

@@ -77,3 +77,19 @@ def test_bad_names_are_one_line_errors_listing_the_technique_robots(override: st
     res = CliRunner().invoke(cli, args)
     lines = res.stderr.strip().splitlines()
     assert res.exit_code == 2 and len(lines) == 1 and lines[0].startswith("error: ") and "SurfVG" in lines[0]
+
+
+def test_evaluate_cli_tables_the_technique_robots(tmp_path) -> None:
+    """``confront evaluate RUN --opponents SurfVG,4v4:RiskGF``: a row per technique robot (a bare name is 1v1)."""
+    from confront.train.factory import train_run
+
+    cfg = load_experiment("demo", ['learner.kind="ppo"', 'league.opponents=["1v1:OrbitLinear"]', "league.focus=[]",
+                                   "league.battles=2", "ppo.rollout_steps=16", "ppo.hidden=32", "train.rounds=4",
+                                   "train.session_rounds=4", "train.replay=false"])
+    train_run(cfg, tmp_path / "run", progress=False)
+    res = CliRunner().invoke(cli, ["evaluate", str(tmp_path / "run"), "--opponents", "SurfVG,4v4:RiskGF",
+                                   "--rounds", "2", "--seed", "1"])
+    assert res.exit_code == 0, res.output
+    rows = [line for line in res.output.splitlines() if line.startswith("| 1v1:SurfVG |")
+            or line.startswith("| 4v4:RiskGF |")]
+    assert len(rows) == 2 and all(float(r.split("|")[3]) < 1.0 for r in rows), res.output  # they score

@@ -110,3 +110,48 @@ def test_rounds_per_battle_is_validated():
 def test_bad_opponent_names_list_the_technique_robots():
     with pytest.raises(ValueError, match="SurfGF"):
         TeamBattleEnv("1v1", opponents="SurfGG")
+
+
+def test_multi_turn_steps_with_waiting_battles_play_as_the_python_turn_loop(monkeypatch):
+    """7 turns a step, 3 battles of a learning tank against SurfVG in 1v1: a battle whose round ends mid-step waits
+    (its technique robot decides nothing) until the step's end starts its next round. Each battle's turns equal a
+    plain loop that starts the next round at once, fed the tank's commands of that battle's turns."""
+    from confront.arena import smdp
+
+    frames: list[tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]] = []
+    env = TeamBattleEnv("1v1", n_battles=3, seed=0, opponents="SurfVG", config=SMDPConfig(turns_per_step=7))
+    env.reset()
+    s = env.arena.state
+    live = [~s.done.copy()]
+
+    def capture(rep, arena, b):  # every turn of a recorded step: who moved, the commands, the robots
+        frames.append((live[0].copy(), env._cmd.copy(), {n: getattr(s, n).copy() for n in ROWS}))
+        live[0] = ~s.done.copy()
+
+    monkeypatch.setattr(smdp, "record_frame", capture)
+    env.recording = (None, 0)
+    rng = np.random.default_rng(2)
+    waited = 0
+    for _ in range(150):
+        live[0] = ~s.done.copy()
+        env.step(rng.integers(0, env.n_actions, size=(3, 2)))
+        waited += int(sum((~f[0]).sum() for f in frames[-7:]))
+    assert waited > 0  # some battles did wait within a step
+    arena, tech = _python_twin(env, [None, "SurfVG"])
+    per_battle = [[(f[1][b], {n: v[b] for n, v in f[2].items()}) for f in frames if f[0][b]] for b in range(3)]
+    s2 = arena.state
+    for k in range(min(len(p) for p in per_battle)):
+        cmd = arena.idle_commands()
+        for b in range(3):
+            cmd[b, 0] = per_battle[b][k][0][0]
+        tech.commands(cmd)
+        for b in range(3):
+            np.testing.assert_array_equal(cmd[b, 1], per_battle[b][k][0][1], err_msg=f"battle {b}, turn {k}")
+        arena.step(cmd)
+        for b in range(3):
+            for name in ROWS:
+                np.testing.assert_array_equal(getattr(s2, name)[b], per_battle[b][k][1][name],
+                                              err_msg=f"{name}, battle {b}, turn {k}")
+        if s2.done.any():
+            arena.reset(s2.done.copy())
+    assert s2.round.min() >= 2  # rounds ended and restarted on the way

@@ -9,6 +9,10 @@ its threads): on a machine shared with other jobs it moves less than the wall-cl
 ``team-env`` rows: :class:`TeamBattleEnv` with learner actions, the learner-facing path: 4v4 against SpinBot,
 T = 10, uniformly random actions of the paper's 4 moves for the 4 learning tanks, ``batch`` battles;
 ``decisions_per_s`` = learner decisions (alive or not) per second, ``robot_turns_per_s`` = alive robots x turns.
+``--team-opponents 1v1:SurfVG,4v4:OrbitGF`` plays those SCENARIO:OPPONENT entries instead (the technique robots of
+confront.arena.tech, or any sample robot; rows name them as ``env:OPPONENT``); ``--scenarios ""`` skips the
+arena rows, e.g. ``python benchmarks/sim_throughput.py --scenarios "" --no-engine --team-opponents
+1v1:SurfVG,4v4:OrbitGF --team-batches 64``.
 ``--plot PNG`` (``confront bench sim --plot``) writes the scaling figure instead: scripted 4v4 and the team env,
 throughput against batch size at 1 and 2 threads.
 
@@ -161,7 +165,8 @@ def team_env(scenario: str, batch: int, seconds: float, threads: int | None = No
         dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         if steps / dt > best[0]:
             best = (steps / dt, robot_turns / dt, steps * batch * turns / dt, steps / cpu)
-    return {"scenario": scenario, "batch": batch, "engine": "team-env", "threads": len(env._ranges),
+    return {"scenario": scenario, "batch": batch, "engine": "team-env", "opponents": opponents,
+            "threads": len(env._ranges),
             "decisions_per_s": best[0] * batch * learners, "robot_turns_per_s": float(best[1]),
             "turns_per_s": best[2], "decisions_per_cpu_s": best[3] * batch * learners}
 
@@ -227,6 +232,8 @@ def main() -> None:
                     help="turns of each ScriptedBots.play call (the bots workload); each call's first turn is slower")
     ap.add_argument("--no-engine", action="store_true", help="skip the real engine")
     ap.add_argument("--team-batches", default="64,256", help="batches of the team-env rows ('' for none)")
+    ap.add_argument("--team-opponents", default="4v4:SpinBot",
+                    help="SCENARIO:OPPONENT entries of the team-env rows, e.g. 1v1:SurfVG,4v4:OrbitGF")
     ap.add_argument("--plot", default=None, metavar="PNG", help="write the scaling figure (and print its rows)")
     args = ap.parse_args()
     if args.turns_per_call < 1:
@@ -241,15 +248,19 @@ def main() -> None:
             print(json.dumps(rows))
         return
     rows: list[dict] = []
-    for sc in args.scenarios.split(","):
+    entries = [e.partition(":") for e in args.team_opponents.split(",") if e]
+    if any(not scen or not opp for scen, _, opp in entries):
+        ap.error(f"--team-opponents takes SCENARIO:OPPONENT entries, got {args.team_opponents!r}")
+    for sc in [v for v in args.scenarios.split(",") if v]:
         for b in BATCHES:
             rows.append(sim_throughput(sc, b, args.seconds, args.order, args.threads, args.workload,
                                        args.turns_per_call))
         rows.append(raw_step(sc, args.seconds, args.order))
         if not args.no_engine:
             rows.extend(engine_rows(sc))
-    for b in [int(v) for v in args.team_batches.split(",") if v]:
-        rows.append(team_env("4v4", b, args.seconds, args.threads))
+    for scen, _, opp in entries:
+        for b in [int(v) for v in args.team_batches.split(",") if v]:
+            rows.append(team_env(scen, b, args.seconds, args.threads, opponents=opp))
     eng = {r["scenario"]: r["robot_turns_per_s"] for r in rows if r["engine"] == "robocode"}
     print(f"order={args.order}, threads={args.threads or 'all CPUs'}, {args.turns_per_call} turns a play() call, "
           f"load average {os.getloadavg()[0]:.1f}")
@@ -261,7 +272,8 @@ def main() -> None:
         # robot-turns (decisions for the team env) per second of the process's CPU time: steadier on a busy machine
         cpu = r.get("decisions_per_cpu_s", r.get("robot_turns_per_cpu_s"))
         per_cpu = f"{cpu:>13,.0f}" if cpu is not None else f"{'':>13}"
-        print(f"{r['scenario']:<8} {r['batch']:>6} {r['engine']:<13} {r['turns_per_s']:>14,.0f} "
+        engine = f"env:{r['opponents']}" if r["engine"] == "team-env" and r["opponents"] != "SpinBot" else r["engine"]
+        print(f"{r['scenario']:<8} {r['batch']:>6} {engine:<13} {r['turns_per_s']:>14,.0f} "
               f"{r['robot_turns_per_s']:>15,.0f} {ratio:>9,.0f} {per_cpu} {dec}")
     if args.json:
         print(json.dumps(rows))

@@ -51,6 +51,7 @@ def workload() -> None:
     from confront.arena.observe import ObservationConfig
     from confront.arena.pool import PoolEntry, PoolEnv
     from confront.arena.pz_env import parallel_env
+    from confront.arena.scenarios import get_scenario
     from confront.arena.smdp import SMDPConfig, TeamBattleEnv
     from confront.arena.tank import MEMORY_ROWS, TankSpace
     from confront.arena.vector_env import BattleVectorEnv
@@ -66,6 +67,7 @@ def workload() -> None:
     pool = PoolEnv([PoolEntry("1v1:dodge", "1v1", "td", 2, policy=paper, opponent_actions="paper"),
                     PoolEntry("4v4:td", "4v4", "td", 2, policy=paper, opponent_actions="paper"),
                     PoolEntry("1v1:SpinBot", "1v1", "SpinBot", 2), PoolEntry("4v4:Walls", "4v4", "Walls", 2),
+                    PoolEntry("1v1:SurfVG", "1v1", "SurfVG", 2), PoolEntry("4v4:OrbitGF", "4v4", "OrbitGF", 2),
                     PoolEntry("4v4:self", "4v4", "td", 2, policy=lambda d, f, r: r.integers(0, 4, size=len(d)))],
                    tank, seed=0)
     pool.reset()
@@ -85,6 +87,9 @@ def workload() -> None:
     bots.play(3)
     bots.commands(arena.idle_commands())
     bot_battle(["Tracker", "RamFire"], 2, seed=0, n_battles=2)
+    from confront.arena.tech import tech_battle  # the technique robots (confront battle --robots SurfGF,...)
+
+    tech_battle(["SurfGF", "SpinBot"], 1, seed=0, scenario=get_scenario("1v1"))
     cmd = arena.idle_commands()  # the Python controller (control.py) with and without scan memory
     memory = np.zeros((arena.n_battles, MEMORY_ROWS, arena.n_robots, arena.n_robots))
     control.remember(memory, arena)

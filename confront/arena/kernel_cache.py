@@ -4,8 +4,9 @@
 (:data:`KERNEL_MODULES`) a :class:`KernelCache`, numba's cache with two changes:
 
 - The source stamp of every kernel is one digest of all kernel module files, not its own file's: numba stores a
-  caller with its callees compiled in (``smdp_turns`` holds the turn of ``kernels.py`` and the bots of
-  ``bots/``), so an entry stamped with its own file alone would run old code after a callee's module changed.
+  caller with its callees compiled in (``smdp_turns`` holds the turn of ``kernels.py``, the bots of
+  ``bots/`` and the technique robots of ``tech.py``), so an entry stamped with its own file alone would run old
+  code after a callee's module changed.
 - On a miss, the kernel is looked up in ``prebuilt/<PREBUILT>/``: numba's cache files of the kernels Python
   calls, compiled by ``scripts/build_kernels.py`` for the x86-64-v3 CPU level (AVX2, FMA, BMI2; the same
   operations in the same order as the host's code: no fast-math, no fused multiply-add, so the same results bit
@@ -38,7 +39,7 @@ HERE = Path(__file__).resolve().parent
 # the modules whose code is compiled into the kernels (functions, and the constants they read); every module of
 # bots/ (the controller and one per robot)
 KERNEL_MODULES = ("rules", "state", "kernels", *(f"bots.{p.stem}" for p in sorted((HERE / "bots").glob("*.py"))),
-                  "observe", "tank", "smdp_kernel")
+                  "observe", "tank", "strictmath", "tech", "smdp_kernel")
 TARGET_CPU = "x86-64-v3"
 # LLVM's names of the x86-64-v2 and -v3 features (the x86-64 psABI levels)
 TARGET_FEATURES = ("cx16", "popcnt", "sahf", "sse3", "sse4.1", "sse4.2", "ssse3", "avx", "avx2", "bmi", "bmi2",

@@ -418,8 +418,9 @@ def _update_bullet(rf, rb, ri, bi, bf, kf, ki, ledger, score, dead, perm_r, perm
 def _bullets_meet(kf, ki, b, s, s2, owner, lx, ly, x, y):
     """Bullet s (owner, moving from (lx, ly) to (x, y) this turn) crosses listed bullet s2's line
     (BulletPeer.checkBulletCollision)."""
-    # segments of at most 19.7 whose start points are 40 apart cannot cross
-    if abs(kf[b, KLX, s2] - lx) >= 40.0 or abs(kf[b, KLY, s2] - ly) >= 40.0:
+    # segments of at most 19.7 whose start points are 40 apart cannot cross, nor does the formula say so unless the
+    # lines are nearly parallel (then its quotients are rounding noise: it may say that lines far apart meet)
+    if (abs(kf[b, KLX, s2] - lx) >= 40.0 or abs(kf[b, KLY, s2] - ly) >= 40.0) and not _nearly_parallel(kf, b, s, s2):
         return False
     st2 = ki[b, KSTATE, s2]
     return s2 != s and (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KLINE, s2] != 0 and \
@@ -428,13 +429,25 @@ def _bullets_meet(kf, ki, b, s, s2, owner, lx, ly, x, y):
 
 
 @njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
+def _nearly_parallel(kf, b, s, s2):
+    """Bullets s and s2 fly within 1e-6 rad of parallel or antiparallel (their steps' cross product): then the
+    quotients of BulletPeer.intersect (rules.segments_intersect) divide by rounding noise and may say that nearly
+    collinear lines meet however far apart they are. At larger angles its results are the geometry's to within
+    1e-5 px, far inside the near-pair filters' margins."""
+    vx, vy, wx, wy = kf[b, KVX, s], kf[b, KVY, s], kf[b, KVX, s2], kf[b, KVY, s2]
+    c = vx * wy - vy * wx
+    return c * c <= 1e-12 * (vx * vx + vy * vy) * (wx * wx + wy * wy)
+
+
+@njit(cache=True, forceinline=True, _nrt=False, error_model="numpy")
 def _mark_near(kf, ki, b, nb, near):
     """The pairs of listed bullets of different owners that can meet this turn: near[0] pairs, the p-th in
     near[1 + 2p], near[2 + 2p] (near[0] = -1 when they do not fit: then every bullet looks at every other).
 
-    _bullets_meet looks only at lines starting within 40 px of its bullet's start; every line of this turn starts at
-    most 19.7 px (one step) from its bullet's point before the turn's bullet updates, so two bullets whose points are
-    60 px apart on an axis cannot meet: the candidates, hence the battle, are unchanged.
+    _bullets_meet looks only at lines starting within 40 px of its bullet's start, or nearly parallel to its line
+    (``_nearly_parallel``); every line of this turn starts at most 19.7 px (one step) from its bullet's point before
+    the turn's bullet updates, so two bullets whose points are 60 px apart on an axis, and not nearly parallel, cannot
+    meet: the candidates, hence the battle, are unchanged.
     """
     cap = (near.shape[0] - 1) // 2
     pairs = 0
@@ -448,7 +461,7 @@ def _mark_near(kf, ki, b, nb, near):
         o = ki[b, KOWNER, s]
         for q in range(p + 1, nb):
             s2 = ki[b, KLIST, q]
-            if abs(kf[b, KX, s2] - x) < 60.0 and abs(kf[b, KY, s2] - y) < 60.0:
+            if (abs(kf[b, KX, s2] - x) < 60.0 and abs(kf[b, KY, s2] - y) < 60.0) or _nearly_parallel(kf, b, s, s2):
                 st2 = ki[b, KSTATE, s2]
                 if (st2 == B_FIRED or st2 == B_MOVING) and ki[b, KOWNER, s2] != o:
                     if pairs == cap:

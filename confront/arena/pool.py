@@ -39,7 +39,7 @@ class PoolEntry:
 
     name: str
     scenario: str
-    opponents: str  # a scripted robot name for every opponent, or "td" (caller-driven: ``policy``)
+    opponents: str  # a sample or technique robot's name for every opponent, or "td" (caller-driven: ``policy``)
     battles: int
     policy: OpponentPolicy | None = None
     opponent_actions: str = "same"  # the caller-driven opponents' action space: "same" or "paper"

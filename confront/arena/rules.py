@@ -145,8 +145,9 @@ def clamp_power(p: float, energy: float) -> float:
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def bullet_speed(p: float) -> float:
-    """20 - 3p (Rules.getBulletSpeed)."""
-    return 20.0 - 3.0 * p
+    """20 - 3p, the power clamped to [0.1, 3] (Rules.getBulletSpeed; a bullet fired with less than 0.1 energy left
+    has that power but the speed of power 0.1)."""
+    return 20.0 - 3.0 * min(max(p, 0.1), 3.0)
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")

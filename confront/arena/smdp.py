@@ -3,9 +3,15 @@
 ``TeamBattleEnv(scenario, n_battles, seed, opponents)`` runs B battles of one scenario. Every robot is
 either a *learning tank* (driven by the caller's actions: the paper's four macro moves, optionally x 3
 fire powers, each held for T turns; its gun and radar follow :mod:`confront.arena.control`'s fixed
-controller) or a *scripted bot* (:mod:`confront.arena.bots`, commands every turn). Team 0 is always
+controller) or a *scripted bot* (:mod:`confront.arena.bots`, commands every turn) or a *technique robot*
+(:mod:`confront.arena.tech`: RamHeadOn, ..., SurfVG, RiskGF, a decision every turn). Team 0 is always
 learning; the other teams follow ``opponents`` (``"td"`` = learning tanks whose actions the caller also
-supplies, e.g. a TD team; a bot name = that sample robot).
+supplies, e.g. a TD team; a bot name = that sample robot or technique robot).
+
+Battles: the technique robots keep memory per round and per battle (GuessFactor visit counts, where enemy
+bullets hit them, virtual-gun hit rates), as a Java robot keeps static fields. A battle is
+``config.rounds_per_battle`` rounds (35: RoboRumble's battle) of a battle row: its memory survives its rounds'
+ends (``auto_reset``, ``restart``) and is cleared when the row's next battle starts, or at ``reset``.
 
 ``step(actions)`` takes (B, R) ints (ignored for scripted and dead robots), runs T turns and returns a
 :class:`StepResult`: observations after the step (discrete state (B, R), features (B, R, F), target
@@ -17,7 +23,8 @@ in ``final_discrete`` / ``final_features``, and ``round_end`` carries the ended 
 ``info``: ``score`` (B, R, 6) this round's parts so far, ``score_total`` (B, R, 6) over decided rounds,
 ``score_parts`` (their names, Robocode's order).
 
-Speed: one compiled kernel runs the T turns (controller, scripted bots, the arena's turn, rewards) and
+Speed: one compiled kernel runs the T turns (controller, scripted bots, technique robots, the arena's turn,
+rewards) and
 the observations; with 8+ battles and several numba threads, battle ranges run on a thread pool.
 Observations equal :func:`confront.arena.observe.observe`'s; the controller equals
 :func:`confront.arena.control.gun_radar_commands` (tested).
@@ -53,6 +60,7 @@ from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, opponent_members
 from .smdp_kernel import Outputs, Senses, Tanks, Views, prepare_actions, smdp_turns
 from .state import SCORE_PARTS
 from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
+from .tech import TECH_ROBOTS, TechBots, no_tech_state
 
 Reward = Literal["eq35", "score"]  # Eq. 35 per turn, or the change of the team's score margin
 
@@ -75,10 +83,14 @@ class SMDPConfig:
     control: ControlConfig = field(default_factory=ControlConfig)
     reward: Reward = "eq35"
     tank: TankSpace | None = None  # the tank view and tank actions (confront.arena.tank) instead of the paper's
+    rounds_per_battle: int = 35  # rounds of one battle: the technique robots' battle memory lives that long
 
     def __post_init__(self) -> None:
         if not isinstance(self.turns_per_step, int) or self.turns_per_step < 1:
             raise ValueError(f"turns_per_step must be an integer >= 1, got {self.turns_per_step!r}")
+        if isinstance(self.rounds_per_battle, bool) or not isinstance(self.rounds_per_battle, int) \
+                or self.rounds_per_battle < 1:
+            raise ValueError(f"rounds_per_battle must be an integer >= 1, got {self.rounds_per_battle!r}")
         if not self.fire_powers or any(not 0.1 <= p <= 3.0 for p in self.fire_powers):
             raise ValueError(f"fire_powers must be non-empty values in [0.1, 3], got {self.fire_powers!r}")
         if self.reward not in REWARDS:
@@ -135,7 +147,8 @@ class StepResult:
 
 
 def resolve_drivers(scenario: Scenario, opponents: str | list[str] | tuple[str, ...] | None) -> list[str | None]:
-    """Per-robot driver: None = learning tank, or a bot name. Team 0 always learns.
+    """Per-robot driver: None = learning tank, or a bot name (a sample robot or a technique robot). Team 0 always
+    learns.
 
     ``opponents``: None = the scenario's default; one name for every robot of the other teams (a sample team,
     ``"MyFirstTeam"``, fills each of them with its leader and droids); or one name per robot of the other teams
@@ -148,9 +161,9 @@ def resolve_drivers(scenario: Scenario, opponents: str | list[str] | tuple[str, 
     if len(names) != others:
         raise ValueError(f"opponents has {len(names)} entries, the other teams have {others} robots")
     for n in names:
-        if n != LEARNER and n not in BOT_NAMES:
-            raise ValueError(f"unknown opponent {n!r}; use {LEARNER!r}, one of {', '.join(BOT_NAMES)} or a sample "
-                             f"team ({', '.join(SAMPLE_TEAMS)})")
+        if n != LEARNER and n not in BOT_NAMES and n not in TECH_ROBOTS:
+            raise ValueError(f"unknown opponent {n!r}; use {LEARNER!r}, one of {', '.join(BOT_NAMES)}, a sample "
+                             f"team ({', '.join(SAMPLE_TEAMS)}) or a technique robot ({', '.join(TECH_ROBOTS)})")
     return [None] * scenario.teams[0] + [None if n == LEARNER else n for n in names]
 
 
@@ -175,7 +188,10 @@ class TeamBattleEnv:
         self.drivers = resolve_drivers(self.scenario, opponents)
         self.learner = np.array([d is None for d in self.drivers])
         self.team = np.asarray(self.scenario.team_ids(), dtype=np.int64)
-        self.bots = ScriptedBots(self.arena, self.drivers) if not self.learner.all() else None
+        samples = [d if d in BOT_NAMES else None for d in self.drivers]
+        self.bots = ScriptedBots(self.arena, samples) if any(samples) else None
+        techs = [d if d in TECH_ROBOTS else None for d in self.drivers]
+        self.tech = TechBots(self.arena, techs, self.config.rounds_per_battle) if any(techs) else None
         set_adjustments(self.arena, self.learner)
         self.field = (float(self.scenario.width), float(self.scenario.height))
         self.max_distance = self.config.observation.max_distance or field_diagonal(*self.field)
@@ -213,6 +229,9 @@ class TeamBattleEnv:
         kinds = self.bots.kinds if self.bots is not None else np.zeros(r, np.int64)
         mem = self.bots.mem if self.bots is not None else np.zeros((b, r, 1))
         self._bot_states = [BotState(kinds, mem, np.zeros(4)) for _ in self._ranges]
+        # and its own technique robots' hit scratch
+        self._tech_states = [self.tech.kernel_state() if self.tech is not None else no_tech_state(r)
+                             for _ in self._ranges]
         self._entry: Callable[..., int] | None = None
         # robots whose tank view is computed (a pool sets its caller-driven robots: nobody reads a bot's view)
         self.view_robots = np.ones(r, dtype=np.bool_)
@@ -265,6 +284,12 @@ class TeamBattleEnv:
     def turns_per_step(self) -> int:
         """T."""
         return self.config.turns_per_step
+
+    @property
+    def completed_battles(self) -> np.ndarray:
+        """(B,) battles of ``rounds_per_battle`` rounds each battle row has finished since :meth:`reset`."""
+        s = self.arena.state
+        return (s.round - 1 + s.done) // self.config.rounds_per_battle
 
     # ------------------------------------------------------------------ observations
     def observe(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -325,6 +350,8 @@ class TeamBattleEnv:
         self._forget(np.ones(self.n_battles, dtype=bool))
         if self.bots is not None:
             self.bots.reset()
+        if self.tech is not None:  # a new battle: the technique robots forget it all
+            self.tech.new_battles(np.ones(self.n_battles, dtype=bool))
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats
@@ -371,9 +398,12 @@ class TeamBattleEnv:
         return a if a.dtype == np.int64 else a.astype(np.int64)
 
     def _sync_bots(self) -> None:
-        """Scripted bots clear their memory when their battle started a new round (as ScriptedBots.commands)."""
+        """Scripted bots clear their memory when their battle started a new round (as ScriptedBots.commands), the
+        technique robots their round's memory, and their battle's when its battle started (TechBots.commands)."""
         if self.bots is not None:
             self.bots.sync_rounds()
+        if self.tech is not None:
+            self.tech.sync_rounds()
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
@@ -423,7 +453,8 @@ class TeamBattleEnv:
         a = self.arena
         ranges = [(0, self.n_battles)] if whole else self._ranges
         return [(lo, hi, t0, t1, *a.bundles, self._cmd, a.settings, a.scratch, self._bot_states[k],
-                 self.bots is not None, self.tanks, self.senses, out, views) for k, (lo, hi) in enumerate(ranges)]
+                 self.bots is not None, self._tech_states[k], self.tech is not None, self.tanks, self.senses, out,
+                 views) for k, (lo, hi) in enumerate(ranges)]
 
     def kernel(self, call: tuple[Any, ...]) -> Callable[..., int]:
         """smdp_turns compiled for the types of this env's calls (looked up once: numba's own dispatch would work
@@ -464,13 +495,15 @@ class TeamBattleEnv:
 
     # ------------------------------------------------------------------ checkpoints
     def state_dict(self) -> dict[str, np.ndarray]:
-        """Arena arrays, the robots' scan memory and the scripted bots' memory (data only)."""
+        """Arena arrays, the robots' scan memory and the scripted and technique robots' memory (data only)."""
         d = {f"arena.{k}": v for k, v in self.arena.state_dict().items()}
         d["control.memory"] = self._memory.copy()
         d["control.slots"] = self._slots.copy()
         d["control.mates"], d["control.mates_ok"] = self._mates.copy(), self._mates_ok.copy()
         if self.bots is not None:
             d.update({f"bots.{k}": v for k, v in self.bots.state_dict().items()})
+        if self.tech is not None:
+            d.update({f"tech.{k}": v for k, v in self.tech.state_dict().items()})
         return d
 
     def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
@@ -489,6 +522,8 @@ class TeamBattleEnv:
             arr[...] = saved
         if self.bots is not None:
             self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
+        if self.tech is not None:
+            self.tech.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("tech.")})
         self._last = self.observe()
 
     def team_ids(self) -> np.ndarray:

@@ -3,9 +3,10 @@
 observations (``smdp_turns``).
 
 ``smdp_turns`` takes the arena's bundles (:mod:`confront.arena.state`'s robots, battles, bullets, radar, scores;
-:mod:`confront.arena.kernels`' settings and scratch), the scripted robots' :class:`~confront.arena.bots.BotState`
-and four of its own: :class:`Tanks` (the learning tanks' step), :class:`Senses` (what the robots know),
-:class:`Outputs` (what the step writes) and :class:`Views` (which observations, of what size).
+:mod:`confront.arena.kernels`' settings and scratch), the scripted robots' :class:`~confront.arena.bots.BotState`,
+the technique robots' :class:`~confront.arena.tech.TechState` and four of its own: :class:`Tanks` (the learning
+tanks' step), :class:`Senses` (what the robots know), :class:`Outputs` (what the step writes) and :class:`Views`
+(which observations, of what size).
 
 A module of its own so that the Python side of the env (smdp.py) can change without recompiling the kernel;
 its numba cache is stamped with all kernel modules' sources (kernel_cache.py), as it holds their code.
@@ -24,6 +25,7 @@ from .kernel_cache import install
 from .observe import float_mod, perceive_row, remember_scans, reward_eq35_scalar, robot_observation, target_of
 from .rules import java_atan2, java_hypot
 from .tank import M_H, M_TURN, M_V, lead_point, tank_view_row
+from .tech import tech_battle_step
 
 __all__ = ["Tanks", "Senses", "Outputs", "Views", "prepare_actions", "relative_angle", "controller_turn",
            "smdp_turns"]
@@ -155,32 +157,34 @@ def controller_turn(rf: np.ndarray, b: int, i: int, tgt: int, tx: float, ty: flo
 
 
 @njit(cache=True, nogil=True)
-def smdp_turns(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tanks,
-               senses, out, views):
+def smdp_turns(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tech,
+               has_tech, tanks, senses, out, views):
     """Turns t0..t1-1 of an SMDP step for battles b0..b1-1 not done: learning tanks' commands (move at
     t = 0, then kept; gun/radar controller every turn, at the chosen target when it is known, with a lead
-    per the action table's lead column), scripted bots, one Robocode turn, rewards (Eq. 35, or the change of
-    the team's score margin with ``ctrl[C_REWARD]``). Then the observations of those battles' robots into target,
-    disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0, of the robots in
-    ``view_mask`` (R,); the others' rows zero, their slots -1; the paper's observations of the robots in
-    ``paper_mask`` (R,), the others' target -1, state and features 0). Returns the turn index
-    where it stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
+    per the action table's lead column), scripted bots, technique robots (``has_tech``), one Robocode turn,
+    rewards (Eq. 35, or the change of the team's score margin with ``ctrl[C_REWARD]``). Then the observations of
+    those battles' robots into target, disc, feats (and the tank view into ``view``, ``slots`` when ``k_slots`` > 0,
+    of the robots in ``view_mask`` (R,); the others' rows zero, their slots -1; the paper's observations of the
+    robots in ``paper_mask`` (R,), the others' target -1, state and features 0). Returns the turn index where it
+    stopped (t1, or earlier when all its battles are done). Battles are independent: ranges can
     run in parallel threads. Each robot picks its target and aims from its own picture
     (observe.perceive_row); after each turn the robots' scans go into ``memory``. The battles are stepped in
     groups of ``group`` (TeamBattleEnv.battle_group); the results do not depend on it."""
     n = robots.f.shape[2]
     return _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots,
-                      tanks, senses, out, views, np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_),
-                      np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]),
+                      tech, has_tech, tanks, senses, out, views, np.empty(n), np.empty(n), np.empty(n),
+                      np.empty(n, dtype=np.bool_), np.zeros((b1 - b0, n)), np.zeros(n), np.zeros(out.feats.shape[2]),
                       np.zeros(out.tank_view.shape[2]), np.empty(n),
                       np.empty(-(-(b1 - b0) // views.group), dtype=np.int64))
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _smdp_turn(b0, b1, t, force, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tanks,
-               senses, out, views, vx, vy, ve, va, before, gain):
+def _smdp_turn(b0, b1, t, force, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tech,
+               has_tech, tanks, senses, out, views, vx, vy, ve, va, before, gain):
     """Turn t of an SMDP step for battles b0..b1-1: the learning tanks' commands (battles done: buf[3] zero),
-    then, unless every battle is done (and not ``force``), the bots, one Robocode turn, scan memory and rewards.
+    then, unless every battle is done (and not ``force``), the scripted bots, the technique robots (of the battles
+    not done: a round's end waits for the step's end, when its battle starts the next round), one Robocode turn,
+    scan memory and rewards.
     Returns False when it stopped because every battle was done."""
     rf, rb, ri = robots
     bi, bb = battles.i, battles.b
@@ -241,6 +245,12 @@ def _smdp_turn(b0, b1, t, force, robots, battles, bullets, radar, scores, cmd, s
         return False
     if has_bots:
         bots_step(b0, b1, bots, robots, radar, cmd, width, height)
+    if has_tech:
+        kf, ki = bullets
+        for b in range(b0, b1):
+            if not bb[b, K.DONE]:
+                tech_battle_step(b, tech.guns, tech.moves, tech.mem, tech.stat, tech.rng, tech.mates, rf, rb, ri, bi,
+                                 kf, ki, scanned, radar.scan_order, cmd, width, height, tech.hit_p, tech.hit_h)
     if views.k_slots > 0 or margin:  # the tank view's team messages and the score margin before this turn
         for b in range(b0, b1):
             mates_ok[b] = True  # what each robot broadcasts to its team-mates this turn (read next turn)
@@ -275,8 +285,8 @@ def _smdp_turn(b0, b1, t, force, robots, battles, bullets, radar, scores, cmd, s
 
 
 @njit(cache=True, nogil=True, _nrt=False)
-def _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tanks,
-               senses, out, views, vx, vy, ve, va, before, gain, row, vrow, dist, stops):
+def _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots, tech,
+               has_tech, tanks, senses, out, views, vx, vy, ve, va, before, gain, row, vrow, dist, stops):
     """:func:`smdp_turns` with its scratch arrays given (vx, vy, ve, va, gain, dist (R,), before (b1 - b0, R),
     row (F,), vrow (view F,) and stops (groups,)): no allocation, so no reference counting of the many views it
     passes on."""
@@ -298,7 +308,8 @@ def _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, set
         stops[g] = t1
         for t in range(t0, t1):
             if not _smdp_turn(g0, g1, t, False, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots,
-                              has_bots, tanks, senses, out, views, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain):
+                              has_bots, tech, has_tech, tanks, senses, out, views, vx, vy, ve, va,
+                              before[g0 - b0:g1 - b0], gain):
                 stops[g] = t
                 break
         t_end = max(t_end, stops[g])
@@ -307,7 +318,7 @@ def _smdp_core(b0, b1, t0, t1, robots, battles, bullets, radar, scores, cmd, set
         g1 = min(b1, g0 + group)
         for t in range(stops[g], t_end):
             _smdp_turn(g0, g1, t, True, robots, battles, bullets, radar, scores, cmd, settings, scratch, bots, has_bots,
-                       tanks, senses, out, views, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain)
+                       tech, has_tech, tanks, senses, out, views, vx, vy, ve, va, before[g0 - b0:g1 - b0], gain)
     # the paper's observations (observe.observe_kernel) of the robots in paper_mask; the others: target -1,
     # state 0, features 0
     for b in range(b0, b1):

@@ -12,6 +12,7 @@ import math
 
 from numba import njit
 
+from .kernel_cache import install
 from .rules import float_bits, float_from_bits
 
 __all__ = ["strict_sin", "strict_cos"]
@@ -165,3 +166,6 @@ def strict_cos(x: float) -> float:
     if q == 2:
         return -_k_cos(y0, y1)
     return _k_sin(y0, y1, 1)
+
+
+install(globals())

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import struct
 from collections.abc import Sequence
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from numba import njit
@@ -34,11 +34,12 @@ from numba import njit
 from . import kernels as K
 from .bots import teammate_masks
 from .core import Arena
+from .kernel_cache import install
 from .rules import java_atan2, java_hypot, java_next_double, java_seed, normal_relative_angle
 from .scenarios import Scenario
 from .strictmath import strict_cos, strict_sin
 
-__all__ = ["TECH_ROBOTS", "TechBots", "tech_kind", "tech_battle", "poses_per_turn"]
+__all__ = ["TECH_ROBOTS", "TechBots", "TechState", "tech_kind", "tech_battle", "tech_battle_step", "poses_per_turn"]
 
 G_HEAD, G_LINEAR, G_CIRCULAR, G_GF, G_VIRTUAL = range(5)
 MV_ORBIT, MV_STOPGO, MV_RAM, MV_SURF, MV_RISK = range(5)
@@ -610,6 +611,30 @@ def tech_step(guns, moves, mem, stat, rng, mates, rf, rb, ri, bi, kf, ki, scanne
                          h, hit_p, hit_h)
 
 
+class TechState(NamedTuple):
+    """What :func:`tech_battle_step` reads and writes, as a compiled turn loop passes it: each robot's gun and
+    movement (R,) (-1: not a technique robot), its memory per round (B, R, M_SIZE) and per battle (B, R, S_SIZE),
+    its java.util.Random (B, R), team-mate bit masks (R,), and the bullets that hit it this turn (power, heading;
+    (MAX_HITS,) scratch: one per thread)."""
+
+    guns: np.ndarray
+    moves: np.ndarray
+    mem: np.ndarray
+    stat: np.ndarray
+    rng: np.ndarray
+    mates: np.ndarray
+    hit_p: np.ndarray
+    hit_h: np.ndarray
+
+
+def no_tech_state(n_robots: int) -> TechState:
+    """A TechState of no technique robots (the same array types as :meth:`TechBots.kernel_state`'s)."""
+    none = np.full(n_robots, -1, dtype=np.int64)
+    return TechState(none, none.copy(), np.zeros((1, n_robots, 1)), np.zeros((1, n_robots, 1)),
+                     np.zeros((1, n_robots), dtype=np.int64), np.zeros(n_robots, dtype=np.int64), np.zeros(MAX_HITS),
+                     np.zeros(MAX_HITS))
+
+
 class TechBots:
     """Technique robots for some robots of an Arena (all battles); battles of ``rounds_per_battle`` rounds."""
 
@@ -657,6 +682,30 @@ class TechBots:
                     self.rng[b, i] = java_seed_of_start(float(s.x[b, i]), float(s.y[b, i]))
             self._round[b] = rnd[b]
 
+    def new_battles(self, mask: np.ndarray) -> None:
+        """The masked battles (B,) started a new battle (``Arena.new_battle``): forget all their memory now."""
+        self._round[np.asarray(mask, dtype=bool)] = -1
+        self.sync_rounds()
+
+    def kernel_state(self) -> TechState:
+        """The robots' arrays for a compiled turn loop (:func:`tech_battle_step`), with their own hit scratch (one
+        per thread)."""
+        return TechState(self.guns, self.moves, self.mem, self.stat, self.rng, self.mates, np.zeros(MAX_HITS),
+                         np.zeros(MAX_HITS))
+
+    def state_dict(self) -> dict[str, np.ndarray]:
+        """The robots' memory (per round, per battle), generators and the round each battle's memory is of."""
+        return {"mem": self.mem.copy(), "stat": self.stat.copy(), "rng": self.rng.copy(), "round": self._round.copy()}
+
+    def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
+        """Restore what :meth:`state_dict` wrote."""
+        for name, arr in (("mem", self.mem), ("stat", self.stat), ("rng", self.rng), ("round", self._round)):
+            saved = d.get(name)
+            if saved is None or np.shape(saved) != arr.shape:
+                got = "missing" if saved is None else f"shape {np.shape(saved)}"
+                raise ValueError(f"technique robots' {name} is {got}, expected shape {arr.shape}")
+            arr[...] = saved
+
     def commands(self, cmd: np.ndarray) -> np.ndarray:
         """Fill the technique robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""
         self.sync_rounds()
@@ -668,7 +717,6 @@ class TechBots:
                   p["bi"], p["kf"], p["ki"], p["scanned"], p["scan_order"], cmd, float(sc.width), float(sc.height),
                   *self._hits)
         return cmd
-
 
 
 def tech_battle(names: list[str], rounds: int, seed: int = 0, n_battles: int = 1, scenario: Scenario | None = None,
@@ -738,3 +786,6 @@ def poses_per_turn(arena: Arena, drivers: Sequence[_Driver], lengths: Sequence[i
                 break
         out.append(np.array(rows))
     return out
+
+
+install(globals())

@@ -135,11 +135,13 @@ def evaluate_cli(run: Path, engine: str, opponents: str | None, rounds: int, see
     names = [o.strip() for o in (opponents or cfg.opponent.kind).split(",") if o.strip()]
     from confront.arena.bots import BOT_NAMES
     from confront.arena.scenarios import SAMPLE_TEAMS, opponent_members
+    from confront.arena.tech import TECH_ROBOTS
 
     for name in names:
-        if name != "td" and name not in BOT_NAMES and name not in SAMPLE_TEAMS:
-            raise click.UsageError(f"unknown opponent {name!r} in --opponents: use td, {', '.join(BOT_NAMES)} or a "
-                                   f"sample team ({', '.join(SAMPLE_TEAMS)})")
+        if name != "td" and name not in BOT_NAMES and name not in SAMPLE_TEAMS and name not in TECH_ROBOTS:
+            raise click.UsageError(f"unknown opponent {name!r} in --opponents: use td, {', '.join(BOT_NAMES)}, a "
+                                   f"sample team ({', '.join(SAMPLE_TEAMS)}) or a technique robot "
+                                   f"({', '.join(TECH_ROBOTS)})")
         try:
             opponent_members(scenario_of(cfg.arena.scenario), name)
         except ValueError as err:

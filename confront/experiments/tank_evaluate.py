@@ -94,6 +94,7 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
     per battle. ``visible``: each battle in Robocode's battle window."""
     from confront.arena.bots import BOT_NAMES
     from confront.arena.scenarios import SAMPLE_TEAMS
+    from confront.arena.tech import TECH_ROBOTS
     from confront.engine.tank_export import evaluate_tank_policy, load_tank_policy
 
     cfg = config_from_dict(load_toml(run / "config.toml"))
@@ -104,7 +105,7 @@ def evaluate_tank_engine_cli(run: Path, opponents: str | None, rounds: int, seed
     click.echo("| opponent | battles | score share (robocode) |\n|---|---:|---:|")
     for entry in league_entries(opponents, cfg):
         scen, _, opp = entry.partition(":")
-        if opp not in BOT_NAMES and opp not in SAMPLE_TEAMS:
+        if opp not in BOT_NAMES and opp not in SAMPLE_TEAMS and opp not in TECH_ROBOTS:
             click.echo(f"| {entry} | - | simulator only |")
             continue
         out[entry] = [evaluate_tank_policy(policy, scen, opp, rounds=rounds, seed=seed + k, visible=visible)[1]

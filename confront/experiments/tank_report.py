@@ -241,13 +241,14 @@ def _evaluate(runs: list[Path], out: Path, rounds: int, engine: bool, engine_see
     if engine:
         from confront.arena.bots import BOT_NAMES
         from confront.arena.scenarios import SAMPLE_TEAMS
+        from confront.arena.tech import TECH_ROBOTS
         from confront.engine.tank_export import load_tank_policy
 
         policy = load_tank_policy(runs[0], play)
         for i, run in enumerate(runs[:engine_runs]):
             pol = policy if i == 0 else load_tank_policy(run, play)
             for e in entries:
-                if e.partition(":")[2] in (*BOT_NAMES, *SAMPLE_TEAMS, *PAPER_MOVE_OPPONENTS):
+                if e.partition(":")[2] in (*BOT_NAMES, *TECH_ROBOTS, *SAMPLE_TEAMS, *PAPER_MOVE_OPPONENTS):
                     real_runs.setdefault(e, []).append([engine_share(run, pol, e, rounds, k + 1, cfgs[i])
                                                         for k in range(engine_seeds)])
         real = {e: v[0] for e, v in real_runs.items()}

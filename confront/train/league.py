@@ -6,9 +6,9 @@
 - The PPO league's others (``league.opponents``, ``SCENARIO:OPPONENT``): ``random`` (uniform paper moves),
   ``dodge`` (a hand-written stochastic dodge over the paper's state and moves), ``strafe`` (a hand-written strafer
   with the learners' own actions and gun), ``self`` (a snapshot of the policy, sampled from the last few); a
-  scripted sample robot (in 4v4 a team of four) otherwise. Opponents in the paper's moves play the paper's
-  controller (no lead, power by distance), also in the engine (:func:`paper_move_robot`). Nothing in a tank's
-  view names its opponent.
+  scripted sample robot or a technique robot (``confront.arena.tech``; in 4v4 a team of four) otherwise.
+  Opponents in the paper's moves play the paper's controller (no lead, power by distance), also in the engine
+  (:func:`paper_move_robot`). Nothing in a tank's view names its opponent.
 
 :func:`build_pool` makes the league a ``PoolEnv`` (all battles, one call per entry).
 """

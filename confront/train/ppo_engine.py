@@ -59,7 +59,7 @@ from confront.train.engine_logs import Decision, ScoreLog, read_decisions, read_
 from confront.train.league import PAPER_MOVE_OPPONENTS, paper_move_robot
 from confront.train.loop import share_by_opponent
 from confront.train.ppo_model import load_tank_model, save_tank_model, tank_space
-from confront.train.spec import SCRIPTED_BOTS, ExperimentConfig
+from confront.train.spec import SCRIPTED_BOTS, TECH_BOTS, ExperimentConfig
 
 __all__ = ["EngineTankTrainer", "episode_rewards", "pack_episodes", "engine_entries"]
 
@@ -111,10 +111,10 @@ def engine_entries(cfg: ExperimentConfig) -> tuple[str, ...]:
         if scen not in SCENARIO_SIZES:
             raise ConfigError(f"league.opponents entry {e!r}: the engine plays the scenarios "
                               f"{', '.join(sorted(SCENARIO_SIZES))}")
-        if opp not in SCRIPTED_BOTS and opp not in SAMPLE_TEAMS and opp not in PAPER_MOVE_OPPONENTS:
+        if opp not in (*SCRIPTED_BOTS, *TECH_BOTS, *SAMPLE_TEAMS, *PAPER_MOVE_OPPONENTS):
             raise ConfigError(f"league.opponents entry {e!r} cannot be played in the engine: use a sample robot "
-                              f"({', '.join(SCRIPTED_BOTS)}), a sample team ({', '.join(SAMPLE_TEAMS)}) or a "
-                              "paper-move opponent "
+                              f"({', '.join(SCRIPTED_BOTS)}), a technique robot ({', '.join(TECH_BOTS)}), a sample "
+                              f"team ({', '.join(SAMPLE_TEAMS)}) or a paper-move opponent "
                               f"({', '.join(PAPER_MOVE_OPPONENTS)}); {opp!r} exists only in the simulator")
     return tuple(cfg.league.opponents)
 

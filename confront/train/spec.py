@@ -20,6 +20,10 @@ CONFIG_PACKAGE = "confront.train.configs"
 # the sample robots of confront.arena.bots.BOT_NAMES that fight on their own, known without loading the simulator (a
 # test keeps them equal); the sample teams (a leader and droids) are SAMPLE_TEAMS
 SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire", "Corners", "Crazy", "TrackFire")
+# the technique robots of confront.arena.tech.TECH_ROBOTS (Java twins confront.tech.*), known without loading the
+# simulator (a test keeps them equal)
+TECH_BOTS = ("RamHeadOn", "StopGoCircular", "OrbitLinear", "OrbitCircular", "OrbitVG", "OrbitGF", "SurfCircular",
+             "SurfGF", "SurfVG", "RiskGF")
 RUN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 
 
@@ -56,12 +60,13 @@ class ArenaSection:
 
 @dataclass
 class OpponentSection:
-    """Who the learning team fights: the TD team (paper §6.3) or scripted robots."""
+    """Who the learning team fights: the TD team (paper §6.3), scripted sample robots or technique robots."""
 
-    kind: str = field("td", doc="'td' for a TD-trained team, or a scripted robot name (e.g. SpinBot)")
+    kind: str = field("td", doc="'td' for a TD-trained team, a scripted sample robot (e.g. SpinBot), a sample team "
+                      "(MyFirstTeam) or a technique robot (RamHeadOn ... SurfVG, RiskGF)")
     model: str = field("", doc="saved TD-team model (.npz); empty = train one first and cache it")
     pretrain_rounds: int = field(300, ge=0, doc="rounds the TD team trains before the experiment")
-    pretrain_against: str = field("SpinBot", doc="scripted robot the TD team trains against")
+    pretrain_against: str = field("SpinBot", doc="scripted or technique robot the TD team trains against")
     learning: bool = field(False, doc="the TD team keeps learning during the experiment")
     alpha: float = field(0.2, gt=0.0, le=1.0, doc="TD team's fixed learning rate")
     gamma: float = field(0.9, ge=0.0, le=1.0)
@@ -69,12 +74,13 @@ class OpponentSection:
 
     def __post_init__(self) -> None:
         for key, value in (("kind", self.kind), ("pretrain_against", self.pretrain_against)):
-            if value in SCRIPTED_BOTS or (key == "kind" and value in ("td", *SAMPLE_TEAMS)):
+            if value in SCRIPTED_BOTS or value in TECH_BOTS or (key == "kind" and value in ("td", *SAMPLE_TEAMS)):
                 continue
             from confront.arena.bots import BOT_NAMES
 
             if value not in BOT_NAMES:
-                allowed = ("td", *BOT_NAMES, *SAMPLE_TEAMS) if key == "kind" else BOT_NAMES
+                robots = (*BOT_NAMES, *TECH_BOTS)
+                allowed = ("td", *robots, *SAMPLE_TEAMS) if key == "kind" else robots
                 raise ValueError(f"opponent.{key} = {value!r} is not allowed: use one of {', '.join(allowed)}")
 
 
@@ -152,9 +158,9 @@ class LeagueSection:
         ("1v1:SittingDuck", "1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Fire", "1v1:Corners",
          "1v1:Crazy", "1v1:dodge", "1v1:self", "4v4:SpinBot", "4v4:Walls", "4v4:Tracker", "4v4:RamFire",
          "4v4:Crazy", "4v4:td", "4v4:dodge", "4v4:self"),
-        doc="SCENARIO:OPPONENT entries: a scripted robot (a team of it), a sample team (MyFirstTeam: a leader and "
-        "droids, in scenarios whose other teams have 2 or more robots), td, random, dodge, strafe, or self "
-        "(snapshots)")
+        doc="SCENARIO:OPPONENT entries: a scripted sample robot or a technique robot (RamHeadOn ... SurfVG, RiskGF; "
+        "a team of it), a sample team (MyFirstTeam: a leader and droids, in scenarios whose other teams have 2 or "
+        "more robots), td, random, dodge, strafe, or self (snapshots)")
     battles: int = field(8, ge=1, le=4096, doc="battles per entry")
     focus: tuple[str, ...] = field((), doc="entries of opponents that get focus_weight times the battles; one "
                                    "written ENTRY*W gets W times")
@@ -174,7 +180,7 @@ class LeagueSection:
     def __post_init__(self) -> None:
         from confront.arena.scenarios import get_scenario, opponent_members, scenario_names
 
-        kinds = (*SCRIPTED_BOTS, *SAMPLE_TEAMS, "td", "random", "dodge", "strafe", "self")
+        kinds = (*SCRIPTED_BOTS, *TECH_BOTS, *SAMPLE_TEAMS, "td", "random", "dodge", "strafe", "self")
         for e in self.opponents:
             scen, _, opp = e.partition(":")
             if scen not in scenario_names() or opp not in kinds:

@@ -18,7 +18,7 @@ SCRIPT = textwrap.dedent("""
     config = SMDPConfig(turns_per_step=2, tank=TankSpace(), reward="score")
     entries = [PoolEntry("1v1/SpinBot", "1v1", "SpinBot", 3), PoolEntry("4v4/Walls", "4v4", "Walls", 2),
                PoolEntry("1v1/td", "1v1", "td", 2, policy=lambda d, f, rng: rng.integers(0, 4, size=len(d)),
-                         opponent_actions="paper")]
+                         opponent_actions="paper"), PoolEntry("1v1/SurfGF", "1v1", "SurfGF", 2)]
     pool = PoolEnv(entries, config, seed=0)
     pool.reset()
     rng = np.random.default_rng(0)

@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
+from confront.arena import kernels as K
 from confront.arena.core import Arena
+from confront.arena.rules import segments_intersect
 from confront.arena.scenarios import get_scenario
 
 
@@ -297,3 +299,52 @@ def test_team_fire_damages_but_scores_nothing():
     assert a.state.energy[0, 1] == pytest.approx(84.0)
     assert a.state.energy[0, 0] == pytest.approx(200.0 - 3.0 + 9.0)
     assert a.state.score[0, 0].sum() == 0.0
+
+
+def test_bullet_of_power_below_0_1_flies_at_the_speed_of_0_1():
+    """A robot with 0.05 energy fires a bullet of power 0.05 that flies at 19.7 px a turn (Rules.getBulletSpeed)."""
+    a = duel([(200, 300, 90), (600, 500, 0)])
+    a.state.energy[0, 0] = 0.05
+    a.state.gun_heat[0, 0] = 0.0
+    a.step(cmd(a, fire=np.array([3.0, 0.0])))
+    slot = a.state.b_list[0, 0]
+    assert a.state.b_power[0, slot] == 0.05
+    step = 20.0 - 3.0 * 0.1
+    assert a.state.b_x[0, slot] == 200.0 + step  # heading east: one step in its firing turn
+    a.step(cmd(a))
+    assert a.state.b_x[0, slot] == 200.0 + step + step
+
+
+def _bullet(a, k, owner, x, y, last_x, last_y, heading, power, state, has_line):
+    """Put a bullet in list entry k (slot k) of battle 0."""
+    s = a.state
+    sp = 20.0 - 3.0 * power
+    s.b_x[0, k], s.b_y[0, k], s.b_last_x[0, k], s.b_last_y[0, k] = x, y, last_x, last_y
+    s.b_heading[0, k], s.b_power[0, k] = heading, power
+    s.b_vx[0, k], s.b_vy[0, k] = sp * math.sin(heading), sp * math.cos(heading)
+    s.b_owner[0, k], s.b_victim[0, k], s.b_state[0, k], s.b_frame[0, k] = owner, -1, state, 0
+    s.b_has_line[0, k] = has_line
+    s.b_list[0, k] = k
+
+
+def test_nearly_collinear_bullets_63_px_apart_meet_as_in_the_engine():
+    """StopGoCircular vs Fire (seed 3, round 64, turn 51): Fire fires back along the line of the other's bullet.
+    Its new bullet moves first and tests the other's last move, which starts 63 px from its own: the lines are
+    parallel to 4e-16 rad and BulletPeer.intersect's quotients are exactly 0 (both numerators are 0 in floating
+    point), so the engine says they meet, and both bullets end as HIT_BULLET."""
+    a = duel([(100, 500, 0), (700, 500, 0)])  # the robots far from the bullets
+    a.state.gun_heat[0] = 3.0
+    fire = (495.92860138609933, 82.25198635726409)  # Fire's bullet, fired this turn: no line yet
+    _bullet(a, 0, 1, *fire, *fire, 5.4301759945002095, 1.0, K.B_FIRED, 0)
+    _bullet(a, 1, 0, 443.17091859148417, 128.3178929550715, 432.77665385043076, 137.39375078943266,
+            2.288583340910416, 2.0670056291958816, K.B_MOVING, 1)
+    a.state.n_bullets[0] = 2
+    nx, ny = fire[0] + a.state.b_vx[0, 0], fire[1] + a.state.b_vy[0, 0]
+    # the hand-computed test the engine makes: Fire's move against the other bullet's last move
+    assert segments_intersect(fire[0], fire[1], nx, ny, 432.77665385043076, 137.39375078943266,
+                              443.17091859148417, 128.3178929550715)
+    assert abs(432.77665385043076 - fire[0]) > 60  # beyond the distances a near-pair filter would look at
+    a.step(cmd(a))  # order "fixed": the bullets move in list order, Fire's first
+    assert a.state.b_state[0, 0] == K.B_HIT_BULLET and a.state.b_state[0, 1] == K.B_HIT_BULLET
+    assert (a.state.b_x[0, 0], a.state.b_y[0, 0]) == fire  # both put back at their last points
+    assert (a.state.b_x[0, 1], a.state.b_y[0, 1]) == (432.77665385043076, 137.39375078943266)

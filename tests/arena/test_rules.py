@@ -47,6 +47,10 @@ def test_turn_rate_at_speed_6_is_5_5_degrees():
 def test_bullet_numbers():
     assert R.bullet_speed(3.0) == 11.0
     assert R.bullet_speed(0.1) == pytest.approx(19.7)
+    # Rules.getBulletSpeed clamps the power to [0.1, 3]: a bullet fired with 0.05 energy left flies at 19.7
+    assert R.bullet_speed(0.05) == R.bullet_speed(0.1) == 20.0 - 3.0 * 0.1
+    assert R.bullet_speed(0.0) == R.bullet_speed(0.1)
+    assert R.bullet_speed(5.0) == 11.0
     assert R.bullet_damage(3.0) == 16.0
     assert R.bullet_damage(1.0) == 4.0
     assert R.bullet_damage(0.5) == 2.0

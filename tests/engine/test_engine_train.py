@@ -142,6 +142,7 @@ def test_engine_resume_refuses_a_simulator_checkpoint(tmp_path: Path) -> None:
                                    "train.rounds=4", "train.session_rounds=1", "train.checkpoint_every=2",
                                    "train.replay=false", "arena.battles=1"])
     train_run(cfg, tmp_path / "run", progress=False)
+    (tmp_path / "run" / "summary.json").unlink()  # as a run killed after its last checkpoint
     with pytest.raises(CheckpointError, match="--engine sim"):
         train_run(None, tmp_path / "run", progress=False, resume=True, engine="robocode")
 

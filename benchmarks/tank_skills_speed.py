@@ -4,7 +4,8 @@ Simulator: ``TeamBattleEnv.step`` turns per second (battles x turns) of tank act
 random joint actions, B battles, 1v1 against SpinBot and 4v4 against SpinBot teams).
 Robocode: the exported TankBot with and without skills (random weights; with skills it surfs about a third of its
 steps) in 1v1 battles against SurfVG (whose waves the brain surfs), the time TankBot spends per turn (its run loop up
-to execute(), System.nanoTime, reported per round as ``turn_us_mean`` / ``turn_us_max``) and the skipped turns;
+to execute(), System.nanoTime, reported per round as ``turn_us_mean``, ``first_turn_us``, ``turn_us_max`` of the
+other turns and ``turns_over_1ms``) and the skipped turns;
 Robocode's time per turn on this machine is its CPU constant, 2.7 ms (robocode-facts.md, section 10).
 
 Usage: ``python benchmarks/tank_skills_speed.py [--seconds 3] [--battles 64] [--rounds 3] [--no-engine] [--json]``.
@@ -68,9 +69,15 @@ def engine_times(space: TankSpace, rounds: int, seed: int = 1) -> dict:
     reports = [r for r in run.summary["robot_reports"] if "tank-round" in r]
     mean = [int(m) for r in reports for m in re.findall(r"turn_us_mean=(\d+)", r)]
     top = [int(m) for r in reports for m in re.findall(r"turn_us_max=(\d+)", r)]
+    at = [int(m) for r in reports for m in re.findall(r"at_turn=(\d+)", r)]
+    first = [int(m) for r in reports for m in re.findall(r"first_turn_us=(\d+)", r)]
+    slow = sum(int(m) for r in reports for m in re.findall(r"turns_over_1ms=(\d+)", r))
+    turns = sum(int(m) for r in reports for m in re.findall(r" turns=(\d+)", r))
     return {"where": "robocode", "scenario": "1v1:SurfVG", "skills": space.skills, "rounds": rounds,
             "turn_us_mean": float(np.mean(mean)) if mean else None, "turn_us_max": max(top) if top else None,
-            "turn_us_max_per_round": top, "skipped_turns": int(sum(run.skipped_turns.values()))}
+            "turn_us_max_per_round": top, "at_turns": at, "first_turn_us": first, "turns_over_1ms": slow,
+            "turns": turns,
+            "skipped_turns": int(sum(run.skipped_turns.values()))}
 
 
 def main() -> None:
@@ -90,7 +97,9 @@ def main() -> None:
             r = engine_times(sp, args.rounds)
             rows.append(r)
             print(f"robocode  1v1:SurfVG skills={r['skills']!s:5s}: TankBot {r['turn_us_mean']} us/turn mean, "
-                  f"{r['turn_us_max']} us max (per round {r['turn_us_max_per_round']}), "
+                  f"{r['turn_us_max']} us max (per round {r['turn_us_max_per_round']} at turns "
+                  f"{r['at_turns']}), {r['turns_over_1ms']} of "
+                  f"{r['turns']} turns over 1 ms (first turns, which get 10 times the time: {r['first_turn_us']} us), "
                   f"{r['skipped_turns']} skipped turns")
     if args.json:
         print(json.dumps(rows))

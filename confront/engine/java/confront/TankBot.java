@@ -65,9 +65,12 @@ public class TankBot extends TeamRobot {
     private final Set<String> heard = new HashSet<>();  // names that sent us a message: team-mates
     private int decisions;
     private int shots;
-    private long turns;  // turns played this round, and the time spent deciding them (ns): total and longest
-    private long busyNs;
+    private long turns;  // turns played this round, and the time spent deciding them (ns): total, the first turn's
+    private long busyNs;  // (Robocode gives it 10 times the time) and the longest of the others
+    private long firstNs;
     private long longestNs;
+    private int slowTurns;  // turns that took over 1 ms
+    private long longestAt;  // the turn (getTime()) of the longest
     private OutputStream log;  // the decision log of this round (confront.tank.log), opened at the first decision
     private boolean detail;
     private TechBrain brain;  // the technique brain of a tank with skills (null without)
@@ -170,7 +173,13 @@ public class TankBot extends TeamRobot {
             long spent = System.nanoTime() - started;
             turns++;
             busyNs += spent;
-            longestNs = Math.max(longestNs, spent);
+            if (turns == 1) {
+                firstNs = spent;
+            } else if (spent > longestNs) {
+                longestNs = spent;
+                longestAt = getTime();
+            }
+            slowTurns += spent > 1_000_000L ? 1 : 0;
             execute();
         }
     }
@@ -371,6 +380,8 @@ public class TankBot extends TeamRobot {
     public void onRoundEnded(RoundEndedEvent e) {
         closeLog();
         out.println("CONFRONT tank-round decisions=" + decisions + " shots=" + shots + " turn_us_mean="
-                + (turns > 0 ? busyNs / turns / 1000 : 0) + " turn_us_max=" + longestNs / 1000);
+                + (turns > 0 ? busyNs / turns / 1000 : 0) + " first_turn_us=" + firstNs / 1000 + " turn_us_max=" + longestNs / 1000 + " at_turn=" + longestAt
+                + " turns_over_1ms="
+                + slowTurns + " turns=" + turns);
     }
 }

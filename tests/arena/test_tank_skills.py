@@ -147,3 +147,18 @@ def test_a_checkpoint_keeps_the_brains() -> None:
     del d["brains.stat"]
     with pytest.raises(ValueError, match="stat is missing"):
         b.load_state_dict(d)
+
+
+def test_the_config_exposes_the_skills() -> None:
+    from confront.config import ConfigError
+    from confront.train.ppo_model import smdp_tank_config, tank_space
+    from confront.train.spec import load_experiment
+
+    assert not tank_space(load_experiment("tanks-demo")).skills  # off unless a config asks
+    cfg = load_experiment("tanks-demo", ['tank.leads=["none", "linear", "circular", "gf"]', "tank.surf=true",
+                                         "tank.knowledge=true"])
+    space = smdp_tank_config(cfg).tank
+    assert space is not None and space.leads[-1] == "gf" and space.surf and space.knowledge
+    assert space.n_features == 70 and space.dims[0] == 6
+    with pytest.raises((ConfigError, ValueError), match="tank.leads entry 'aimbot'"):
+        load_experiment("tanks-demo", ['tank.leads=["aimbot"]'])

@@ -49,27 +49,39 @@ def test_policy_files_without_skills_are_as_before(tmp_path: Path) -> None:
     assert "surf 1\nknowledge 1\n" in _policy(2).to_text() and "leads none circular gf\n" in _policy(2).to_text()
 
 
+# fixed starts (1v1), or the engine's own from its seed (4v4: the simulator draws Robocode's random processing
+# order only when it also draws the start positions, and team-mates' collisions depend on that order; docs/engine.md)
+SEED = 1  # the engine's and the simulator's
+STARTS = {"1v1": ((150.0, 120.0, 30.0), (550.0, 420.0, 200.0)), "4v4": None}
+
+
 @pytest.mark.engine
-def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path) -> None:
-    """1v1 against SpinBot from fixed starts: every robot's pose and energy agree at every turn while both live (up
-    to the first bullet-bullet hit, docs/engine.md), and every decision's view and action (TankBot's decision log)
-    equal the simulator's. The policy picks surf, gf and the knowledge block varies: counted."""
+@pytest.mark.parametrize("scenario", ["1v1", "4v4"])
+def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, scenario) -> None:
+    """Against SpinBot (a team of them in 4v4, where the brain moves by minimum risk): every robot's pose and
+    energy agree at every turn while all live (1v1 from fixed starts: up to the first bullet-bullet hit, whose order
+    is random there; docs/engine.md),
+    and every decision's view and action (TankBot's decision log) equal the simulator's. The policy picks surf and
+    gf, and the knowledge block sees waves (1v1): counted."""
+    import dataclasses
+
     from confront.arena.scenarios import get_scenario
-    from confront.engine.battle import BattleSpec
+    from confront.engine.battle import scenario_battle
     from confront.engine.runner import EngineOptions, run_battle
     from confront.train.engine_logs import read_decisions
 
-    p = _policy(6)
+    p = _policy(6 if scenario == "1v1" else 2)
     b2 = p.biases[-1].copy()
     b2[len(SKILLS.distances)] += 1.5  # surf more often
     policy = TankPolicy(p.weights, (*p.biases[:-1], b2), SKILLS, p.control, p.step_turns)
-    starts = ((150.0, 120.0, 30.0), (550.0, 420.0, 200.0))
+    starts = STARTS[scenario]
+    n_tanks = 1 if scenario == "1v1" else 4
     jar = export_tank_robot(policy, tmp_path / "tankbot.jar", install)
     trace, log = tmp_path / "trace.jsonl", tmp_path / "log"
     log.mkdir()
-    run = run_battle(BattleSpec(("confront.TankBot 1.0", "SpinBot"), rounds=1, max_turns=600,
-                                initial_positions=starts),
-                     EngineOptions(seed=1, cpu_constant_ms=50.0, nosecurity=True,
+    spec = scenario_battle(scenario, "confront.TankBot 1.0", "SpinBot", rounds=1)
+    run = run_battle(dataclasses.replace(spec, max_turns=600, initial_positions=starts or ()),
+                     EngineOptions(seed=SEED, cpu_constant_ms=50.0, nosecurity=True,
                                    extra_jvm_args=(f"-Dconfront.tank.log={log}",)), trace=trace, extra_robots=[jar])
     assert not run.errors and not sum(run.skipped_turns.values())
     assert not [r for r in run.summary["robot_reports"] if "tank-error" in r or "Exception" in r]
@@ -78,37 +90,40 @@ def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path) ->
     eng = np.array([[[r[k] for k in keys] for r in t["robots"]] for t in turns])
     clash = [i for i, t in enumerate(turns) if any(b["state"] == "HIT_BULLET" for b in t["bullets"])]
 
-    env = TeamBattleEnv(get_scenario("1v1").replace(initial_positions=starts, max_turns=100000), 1, seed=1,
+    env = TeamBattleEnv(get_scenario(scenario).replace(initial_positions=starts, max_turns=100000), 1, seed=SEED,
                         opponents="SpinBot", config=SMDPConfig(turns_per_step=policy.step_turns, tank=policy.space,
                                                                reward="score", auto_reset=False))
-    _, feats = env.reset()
+    _, feats = env.reset(seed=SEED)  # the engine's start positions and processing order (4v4)
     env.start_recording(0)
     views = {}
     while env.arena.state.time[0] < len(eng) and not env.arena.state.done[0]:
-        views[int(env.arena.state.time[0])] = feats[0, 0].copy()
-        feats = env.step(np.array([[policy.act(feats[0, 0]), 0]])).features
+        alive = env.arena.state.alive[0]
+        views.update({(i, int(env.arena.state.time[0])): feats[0, i].copy() for i in range(n_tanks) if alive[i]})
+        acts = [policy.act(feats[0, i]) if i < n_tanks else 0 for i in range(2 * n_tanks)]
+        feats = env.step(np.array([acts])).features
     replay = env.stop_recording()
     sim = np.array([r for r, t in zip(replay.robots, replay.turn, strict=True) if t >= 1])[:, :, :6]
     sim[:, :, 2:5] = np.radians(sim[:, :, 2:5])
     n = min(len(sim), len(eng))
     alive = (eng[:n, :, 5] > 0).all(axis=1)
     n = int(np.argmin(alive)) + 1 if not alive.all() else n
-    n = min([n] + clash)
-    assert n > 200
+    n = min([n] + (clash if starts is not None else []))  # replayed from its start, the random order is the engine's
+    assert n > 150, n
     d = np.abs(eng[:n] - sim[:n])
     d[..., 2:5] = np.abs((eng[:n, :, 2:5] - sim[:n, :, 2:5] + math.pi) % (2 * math.pi) - math.pi)
     bad = np.flatnonzero(d.max(axis=(1, 2)) > 1e-6)
     assert bad.size == 0, f"turn {bad[0] + 1}: engine {eng[bad[0]]}, simulator {sim[bad[0]]}"
 
     decisions = [x for x in read_decisions(log) if x.turn < n]
-    assert len(decisions) >= n // policy.step_turns
+    assert len(decisions) >= n_tanks * (n // policy.step_turns)
     surf = gf = waves = 0
     for x in decisions:
-        want = views[x.turn]
-        np.testing.assert_array_equal(x.view.astype(np.float32), want, err_msg=f"turn {x.turn}")
+        robot = int(x.robot.split("(")[1].rstrip(")")) - 1 if "(" in x.robot else 0
+        want = views[(robot, x.turn)]
+        np.testing.assert_array_equal(x.view.astype(np.float32), want, err_msg=f"{x.robot} turn {x.turn}")
         assert x.action == policy.act(want)
         dist, _, _, _, lead = np.unravel_index(x.action, SKILLS.dims)
         surf += dist == len(SKILLS.distances)
         gf += SKILLS.leads[lead] == "gf"
         waves += want[66] > 0
-    assert surf >= 5 and gf >= 5 and waves >= 5, (surf, gf, waves, len(decisions))
+    assert surf >= 5 and gf >= 5 and (waves >= 5 or scenario != "1v1"), (surf, gf, waves, len(decisions))

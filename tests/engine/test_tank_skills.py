@@ -49,16 +49,17 @@ def test_policy_files_without_skills_are_as_before(tmp_path: Path) -> None:
     assert "surf 1\nknowledge 1\n" in _policy(2).to_text() and "leads none circular gf\n" in _policy(2).to_text()
 
 
-# fixed starts (1v1), or the engine's own from its seed (4v4: the simulator draws Robocode's random processing
-# order only when it also draws the start positions, and team-mates' collisions depend on that order; docs/engine.md)
+# fixed starts, or the engine's own from its seed (the simulator draws Robocode's random processing order only when
+# it also draws the start positions; bullet-bullet hits and team-mates' collisions depend on that order; engine.md)
 SEED = 1  # the engine's and the simulator's
-STARTS = {"1v1": ((150.0, 120.0, 30.0), (550.0, 420.0, 200.0)), "4v4": None}
+STARTS = {("1v1", "SpinBot"): ((150.0, 120.0, 30.0), (550.0, 420.0, 200.0))}
 
 
 @pytest.mark.engine
-@pytest.mark.parametrize("scenario", ["1v1", "4v4"])
-def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, scenario) -> None:
-    """Against SpinBot (a team of them in 4v4, where the brain moves by minimum risk): every robot's pose and
+@pytest.mark.parametrize(("scenario", "opponent"), [("1v1", "SpinBot"), ("1v1", "SurfVG"), ("4v4", "SpinBot")])
+def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, scenario, opponent) -> None:
+    """Against SpinBot (a team of them in 4v4, where the brain moves by minimum risk) and the technique robot
+    SurfVG (a wave surfer with virtual guns, in both): every robot's pose and
     energy agree at every turn while all live (1v1 from fixed starts: up to the first bullet-bullet hit, whose order
     is random there; docs/engine.md),
     and every decision's view and action (TankBot's decision log) equal the simulator's. The policy picks surf and
@@ -74,12 +75,12 @@ def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, sc
     b2 = p.biases[-1].copy()
     b2[len(SKILLS.distances)] += 1.5  # surf more often
     policy = TankPolicy(p.weights, (*p.biases[:-1], b2), SKILLS, p.control, p.step_turns)
-    starts = STARTS[scenario]
+    starts = STARTS.get((scenario, opponent))
     n_tanks = 1 if scenario == "1v1" else 4
     jar = export_tank_robot(policy, tmp_path / "tankbot.jar", install)
     trace, log = tmp_path / "trace.jsonl", tmp_path / "log"
     log.mkdir()
-    spec = scenario_battle(scenario, "confront.TankBot 1.0", "SpinBot", rounds=1)
+    spec = scenario_battle(scenario, "confront.TankBot 1.0", opponent, rounds=1)
     run = run_battle(dataclasses.replace(spec, max_turns=600, initial_positions=starts or ()),
                      EngineOptions(seed=SEED, cpu_constant_ms=50.0, nosecurity=True,
                                    extra_jvm_args=(f"-Dconfront.tank.log={log}",)), trace=trace, extra_robots=[jar])
@@ -91,7 +92,7 @@ def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, sc
     clash = [i for i, t in enumerate(turns) if any(b["state"] == "HIT_BULLET" for b in t["bullets"])]
 
     env = TeamBattleEnv(get_scenario(scenario).replace(initial_positions=starts, max_turns=100000), 1, seed=SEED,
-                        opponents="SpinBot", config=SMDPConfig(turns_per_step=policy.step_turns, tank=policy.space,
+                        opponents=opponent, config=SMDPConfig(turns_per_step=policy.step_turns, tank=policy.space,
                                                                reward="score", auto_reset=False))
     _, feats = env.reset(seed=SEED)  # the engine's start positions and processing order (4v4)
     env.start_recording(0)

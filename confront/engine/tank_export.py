@@ -3,10 +3,13 @@ standalone Robocode robot ``confront.TankBot``, with its Java inference (``TankM
 :class:`TankPolicy` is the Python twin: the same view (the simulator's ``tank_view_row``, fed what the robot
 knows), the same action (greedy, or sampled from uniform draws: ``play``) and the same gun/radar controller
 (``smdp.controller_turn`` with ``tank.lead_point``: no lead, linear, or circular with the turn rate of
-``observe.remember_scans``).
+``observe.remember_scans``; gf with the technique brain's angle, ``robot_control``'s ``gun_aim``). The twin has no
+technique brain: with skills, the exported robot is checked against the simulator's battles
+(tests/engine/test_tank_skills.py).
 
 Policy file (text, data only): ``confront-tank 1``, ``key value`` lines (lists as space-separated values;
-``play sampled`` for a robot that samples its actions, greedy without it) and ``matrix NAME ROWS COLS``
+``play sampled`` for a robot that samples its actions, greedy without it; the skills ``surf 1``, ``knowledge 1``
+and the lead ``gf``, absent when off, so older files read as before) and ``matrix NAME ROWS COLS``
 blocks: ``w0 b0 w1 b1 ...``, weights as (out, in), tanh between layers, the last layer's outputs the logits
 of the five heads (distance, body turn, fire power, enemy slot, gun lead) in order.
 

@@ -128,3 +128,22 @@ def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, sc
         gf += SKILLS.leads[lead] == "gf"
         waves += want[66] > 0
     assert surf >= 5 and gf >= 5 and (waves >= 5 or scenario != "1v1"), (surf, gf, waves, len(decisions))
+
+
+def test_the_twins_gf_lead_turns_the_gun_to_the_brains_angle() -> None:
+    """robot_control with the lead gf: the gun to the given angle (radar and fire rule as without a lead), circular
+    when the brain has no angle."""
+    from confront.engine.tank_export import robot_control
+
+    row = [500.0, 400.0, 50.0, 0.5, 8.0, 0.0, 4.0, 0.05]  # x, y, energy, heading, velocity, drop, scan time, rate
+    args = (400.0, 300.0, 0.3, 0.2, 0.0, 100.0, [row], 0, 2.0, 5.0, 800.0, 600.0)
+    c = ControlConfig()
+    assert robot_control(c, "gf", *args) == robot_control(c, "circular", *args)
+    assert robot_control(c, "gf", *args) != robot_control(c, "linear", *args)
+    gun, radar, fire = robot_control(c, "gf", *args, gun_aim=1.0)
+    assert gun == pytest.approx(1.0 - 0.3, abs=1e-15) and fire == 0.0  # 0.7 rad off: no shot
+    assert radar == robot_control(c, "none", *args)[1]
+    bearing = math.atan2(100.0, 100.0)
+    assert robot_control(c, "gf", *args, gun_aim=0.3 + 0.01)[0] == pytest.approx(0.01, abs=1e-15)
+    assert robot_control(c, "gf", *args, gun_aim=0.3 + 0.01)[2] == 2.0  # within the tolerance, cold: fires
+    assert abs(bearing - 0.3) > c.aim_tolerance

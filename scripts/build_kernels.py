@@ -79,6 +79,13 @@ def workload() -> None:
         env.reset()
         for _ in range(3):
             env.step(rng.integers(0, env.config.n_actions, size=(env.n_battles, env.n_robots)))
+    # the tank's skills (confront.arena.tank): the technique brain in the SMDP step, the knowledge block on reset
+    skills = TankSpace(leads=("none", "gf"), surf=True, knowledge=True)
+    env = TeamBattleEnv("1v1", n_battles=2, seed=0, opponents="SpinBot",
+                        config=SMDPConfig(turns_per_step=5, tank=skills, reward="score"))
+    env.reset()
+    for _ in range(3):
+        env.step(rng.integers(0, env.config.n_actions, size=(env.n_battles, env.n_robots)))
     # the arena alone, scripted battles, the Gymnasium / PettingZoo envs
     arena = Arena("4v4", 4, seed=0)
     arena.step(arena.idle_commands())

@@ -57,10 +57,10 @@ from .kernel_cache import entry
 from .observe import SENSING, TARGET_RULES, ObservationConfig, field_diagonal, observe, team_rows
 from .replay import Replay, new_replay, record_frame
 from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, opponent_members
-from .smdp_kernel import Outputs, Senses, Tanks, Views, prepare_actions, smdp_turns
+from .smdp_kernel import Brains, Outputs, Senses, Tanks, Views, prepare_actions, smdp_turns
 from .state import SCORE_PARTS
-from .tank import MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
-from .tech import TECH_ROBOTS, TechBots, no_tech_state
+from .tank import KNOWLEDGE_FEATURES, MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
+from .tech import BRAIN, TECH_ROBOTS, TechBots, knowledge_kernel, no_tech_state
 
 Reward = Literal["eq35", "score"]  # Eq. 35 per turn, or the change of the team's score margin
 
@@ -202,7 +202,7 @@ class TeamBattleEnv:
         b, r = self.n_battles, self.n_robots
         if opponent_actions not in ("same", "paper"):
             raise ValueError(f"opponent_actions must be 'same' or 'paper', got {opponent_actions!r}")
-        self._move = np.zeros((b, r, 4))  # distance, body turn, 1 = turn relative to the target, lead (LEADS)
+        self._move = np.zeros((b, r, 5))  # distance, body turn, 1 = turn relative to the target, lead (LEADS), surf
         self._power = np.zeros((b, r))
         self._chosen = np.full((b, r), -1, dtype=np.int64)  # the step's chosen target robot (-1: by rule)
         tank = self.config.tank
@@ -214,6 +214,7 @@ class TeamBattleEnv:
         self._mates = np.zeros((b, 3, r))  # x, y, energy of every robot one turn ago (team messages, tank.py)
         self._mates_ok = np.zeros(b, dtype=np.bool_)  # False in a round's first turn: no message yet
         self._turn_buf = np.zeros((4, b, r))  # per turn: target, own energy, target energy, live
+        self._brain_cmd = np.zeros((b, r, 5))  # the commands the tanks' brains proposed this turn
         c = self.config.control
         ctrl = np.array([c.radar_overshoot, c.aim_tolerance, c.power_near, c.power_mid, c.power_far,
                          c.near_distance, c.far_distance, float(c.fire), float(REWARDS[self.config.reward])])
@@ -221,6 +222,9 @@ class TeamBattleEnv:
                             TARGET_RULES[self.config.observation.target], self.config.observation.reward_guard,
                             SENSING[self.config.observation.sensing])
         self.senses = Senses(self._memory, self._mates, self._mates_ok)
+        self.brains = _brains(self.arena, self.config.tank, np.isin(self._space, (0, 1) if opponent_actions == "same"
+                                                                      else (0,)), self.team,
+                              self.config.rounds_per_battle)
         threads = numba.get_num_threads()
         chunks = threads if b >= _PARALLEL_MIN_BATTLES and threads > 1 else 1
         size = -(-b // chunks)
@@ -232,6 +236,10 @@ class TeamBattleEnv:
         # and its own technique robots' hit scratch
         self._tech_states = [self.tech.kernel_state() if self.tech is not None else no_tech_state(r)
                              for _ in self._ranges]
+        # and its own learning tanks' technique brains (tank skills: the knowledge block with tank.knowledge)
+        knows = bool(self.config.tank is not None and self.config.tank.knowledge and self.brains is not None)
+        self._brain_states = [Brains(self.brains.kernel_state() if self.brains is not None else no_tech_state(r),
+                                     self._brain_cmd, knows) for _ in self._ranges]
         self._entry: Callable[..., int] | None = None
         # robots whose tank view is computed (a pool sets its caller-driven robots: nobody reads a bot's view)
         self.view_robots = np.ones(r, dtype=np.bool_)
@@ -330,6 +338,10 @@ class TeamBattleEnv:
         tank_view_kernel(x, y, h, s.velocity[rows], e, s.gun_heat[rows], alive, team_rows(self.team, x.shape), memory,
                          seen, s.time[rows].astype(np.float64), self.field[0], self.field[1], tank.enemy_slots,
                          tank.mate_slots, self._mates[rows], self._mates_ok[rows], view, slots)
+        if self.brains is not None and tank.knowledge:
+            b = self.brains
+            knowledge_kernel(b.guns >= 0, b.mem[rows], b.stat[rows], x, y, s.time[rows], tank.n_features -
+                             KNOWLEDGE_FEATURES, view)
         self._mask_views(view, slots)
         feats[rows] = view
         self._slots[rows] = slots
@@ -352,6 +364,8 @@ class TeamBattleEnv:
             self.bots.reset()
         if self.tech is not None:  # a new battle: the technique robots forget it all
             self.tech.new_battles(np.ones(self.n_battles, dtype=bool))
+        if self.brains is not None:
+            self.brains.new_battles(np.ones(self.n_battles, dtype=bool))
         target, disc, feats = self.observe()
         self._last = (target, disc, feats)
         return disc, feats
@@ -370,6 +384,8 @@ class TeamBattleEnv:
         """A new round in the masked battles (B,): no scans remembered, no team message received yet."""
         self._memory[mask] = 0.0
         self._mates_ok[mask] = False
+        if self.brains is not None:  # a new round: the brains forget the round (and a new battle's, the battle)
+            self.brains.sync_rounds()
 
     def start_recording(self, battle: int = 0, names: list[str] | None = None) -> Replay:
         """Record battle ``battle`` turn by turn into a new :class:`Replay` (until stop_recording)."""
@@ -404,6 +420,8 @@ class TeamBattleEnv:
             self.bots.sync_rounds()
         if self.tech is not None:
             self.tech.sync_rounds()
+        if self.brains is not None:
+            self.brains.sync_rounds()
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Hold each learning tank's action for T turns; return observations, (B, R, T) rewards, ends."""
@@ -454,7 +472,7 @@ class TeamBattleEnv:
         ranges = [(0, self.n_battles)] if whole else self._ranges
         return [(lo, hi, t0, t1, *a.bundles, self._cmd, a.settings, a.scratch, self._bot_states[k],
                  self.bots is not None, self._tech_states[k], self.tech is not None, self.tanks, self.senses, out,
-                 views) for k, (lo, hi) in enumerate(ranges)]
+                 views, self._brain_states[k]) for k, (lo, hi) in enumerate(ranges)]
 
     def kernel(self, call: tuple[Any, ...]) -> Callable[..., int]:
         """smdp_turns compiled for the types of this env's calls (looked up once: numba's own dispatch would work
@@ -504,6 +522,8 @@ class TeamBattleEnv:
             d.update({f"bots.{k}": v for k, v in self.bots.state_dict().items()})
         if self.tech is not None:
             d.update({f"tech.{k}": v for k, v in self.tech.state_dict().items()})
+        if self.brains is not None:
+            d.update({f"brains.{k}": v for k, v in self.brains.state_dict().items()})
         return d
 
     def load_state_dict(self, d: dict[str, np.ndarray]) -> None:
@@ -524,6 +544,8 @@ class TeamBattleEnv:
             self.bots.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("bots.")})
         if self.tech is not None:
             self.tech.load_state_dict({k[5:]: v for k, v in d.items() if k.startswith("tech.")})
+        if self.brains is not None:
+            self.brains.load_state_dict({k[7:]: v for k, v in d.items() if k.startswith("brains.")})
         self._last = self.observe()
 
     def team_ids(self) -> np.ndarray:
@@ -534,7 +556,7 @@ class TeamBattleEnv:
 # ---------------------------------------------------------------------- compiled SMDP turns (smdp_kernel)
 def _action_tables(cfg: SMDPConfig, learner: np.ndarray, team: np.ndarray, opponent_actions: str
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Action tables (2, A, 6) of (distance, body turn, fire power, target slot, relative turn, lead) rows,
+    """Action tables (2, A, 7) of (distance, body turn, fire power, target slot, relative turn, lead, surf) rows,
     0 = the learners', 1 = the caller-driven opponents'; each robot's table (R,) (-1: scripted); actions per
     table (2,).
     Fire power 0 = by distance (the paper's controller), -1 = hold fire; slot -1 = the target rule's."""
@@ -542,13 +564,25 @@ def _action_tables(cfg: SMDPConfig, learner: np.ndarray, team: np.ndarray, oppon
     a = np.arange(cfg.paper_actions)
     powers = np.asarray(cfg.fire_powers)[a // N_MOVES] if cfg.fire_power_actions else np.zeros(a.size)
     paper = np.stack([dist[a % N_MOVES], turn[a % N_MOVES], powers, np.full(a.size, -1.0), np.zeros(a.size),
-                      np.zeros(a.size)], axis=1)
+                      np.zeros(a.size), np.zeros(a.size)], axis=1)
     ours = action_table(cfg.tank) if cfg.tank is not None else paper
     theirs = paper if opponent_actions == "paper" else ours
-    tables = np.zeros((2, max(len(ours), len(theirs)), 6))
+    tables = np.zeros((2, max(len(ours), len(theirs)), 7))
     tables[0, :len(ours)], tables[1, :len(theirs)] = ours, theirs
     space = np.where(learner, np.where(team == 0, 0, 1), -1).astype(np.int64)
     return tables, space, np.array([len(ours), len(theirs)], dtype=np.int64)
+
+
+
+
+def _brains(arena: Arena, tank: TankSpace | None, tank_actions: np.ndarray, team: np.ndarray,
+            rounds_per_battle: int) -> TechBots | None:
+    """The technique brains of the robots acting in the tank actions (``tank_actions`` (R,)) when the tank has
+    skills (tank.py), else None; a brain's team-mates are its team's robots."""
+    if tank is None or not tank.skills or not tank_actions.any():
+        return None
+    mates = [int(sum(1 << j for j in range(len(team)) if team[j] == team[i])) for i in range(len(team))]
+    return TechBots(arena, [BRAIN if on else None for on in tank_actions], rounds_per_battle, mates)
 
 
 _PARALLEL_MIN_BATTLES = 8

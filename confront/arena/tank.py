@@ -2,7 +2,8 @@
 
 Angles follow Robocode: radians, 0 = north (+y), clockwise; x right, y up; distances in px, time in turns.
 
-Tank view (float32, ``n_features(K, M) = 11 + 9 K + 5 M``; 62 with K = 4 enemy slots, M = 3 mate slots),
+Tank view (float32, ``n_features(K, M) = 11 + 9 K + 5 M`` (+ 8 with ``knowledge``); 62 with K = 4 enemy slots,
+M = 3 mate slots),
 everything a real robot can know (its own getters, its radar's ScannedRobotEvents, team messages):
 
 | index | feature | scale |
@@ -28,6 +29,12 @@ everything a real robot can know (its own getters, its radar's ScannedRobotEvent
 | +1, +2 | sin, cos of its bearing from the own heading | [-1, 1] |
 | +3 | distance / field diagonal | [0, 1] |
 | +4 | its energy / 100 | [0, ~2] |
+| knowledge (8, with ``knowledge``): | what the tank's technique brain (below) knows, as of its last turn | |
+| +0-3 | rolling hit rates of the brain's virtual guns: head-on, linear, circular, GuessFactor (battle) | [0, 1] |
+| +4 | enemy waves in the air (the enemy's detected shots at us, 1v1): min(n, 4) / 4 | [0, 1] |
+| +5 | turns until the nearest of them reaches us, min(t, 50) / 50 (1 without one) | [0, 1] |
+| +6 | share of the visits in the GuessFactor bin of its last aim this round (0 before one): how peaked | [0, 1] |
+| +7 | share of the surfing danger (where its bullets hit us, battle memory) in its peak bin | [0, 1] |
 
 A team-mate is known from its team messages, which arrive the turn after they are sent: its x, y and energy
 one turn ago, and none in a round's first turn. Nothing names an opponent. The slot map ``slots`` (B, R, K)
@@ -39,8 +46,26 @@ Tank actions: five heads, one joint integer ``(((d * n_turns + t) * n_fire + f) 
 that puts the body at that angle (rad, + clockwise) to the target's bearing, so 0 faces it and +-90 deg
 circles it; ``"body"`` or no known target: a turn by that angle), a fire power
 (0 = hold fire), the enemy slot to target, and the gun's lead (none: at the last scanned position; linear;
-circular: with the turn rate between scans). The fixed gun/radar controller (paper §6.1) then aims at that
-target every turn (``lead_point``) and fires with the chosen power when the gun is on target and cold.
+circular: with the turn rate between scans; gf: the brain's GuessFactor aim, below). The fixed gun/radar controller
+(paper §6.1) then aims at that target every turn (``lead_point``) and fires with the chosen power when the gun is on
+target and cold.
+
+Skills (opt-in; all off: the tank of before, bit for bit). A tank with any of them carries a *technique brain*:
+the decision code of the technique robot SurfGF (:mod:`confront.arena.tech`, Java ``confront.tech.TechBrain``), run
+for the tank every turn on the tank's own events, its commands proposed, not sent. Its memory is a technique
+robot's: per round (enemy waves, gun waves) and per battle of ``rounds_per_battle`` rounds (GuessFactor visit
+counts, where enemy bullets hit us, virtual-gun hit rates), cleared when a new battle starts. The tank's radar
+controller drives the radar (the brain's radar command is dropped; the brain sees the scans the tank's radar
+makes).
+
+| option | what | encoding |
+|---|---|---|
+| ``leads`` with ``"gf"`` | the gun turns to the brain's GuessFactor angle for the target (its bin's factor x the \
+escape angle of the step's bullet power, 2 when none) when the brain aimed at that target this turn; else circular \
+| a lead head value |
+| ``surf = True`` | during the step the body follows the brain's movement every turn (wave surfing in 1v1, minimum \
+risk with more enemies); the turn head is ignored | an extra last entry of the distance head (distance 0) |
+| ``knowledge = True`` | the knowledge block above at the end of the tank view | 8 more features |
 
 Scan memory rows (``memory`` (B, MEMORY_ROWS, R, R), ``[b, :, i, j]`` = robot j at robot i's last scan of
 it): x, y, energy, heading, velocity, energy drop since the previous scan, 1 when scanned this round, its
@@ -60,7 +85,7 @@ from .kernel_cache import install
 from .rules import java_atan2, java_hypot
 
 __all__ = ["TankSpace", "MEMORY_ROWS", "n_features", "tank_view_row", "tank_view_kernel", "lead_point",
-           "action_table", "FEATURE_NAMES"]
+           "action_table", "FEATURE_NAMES", "KNOWLEDGE_FEATURES", "LEADS"]
 
 MEMORY_ROWS = 9  # x, y, energy, heading, velocity, energy drop, scanned this round, turn rate, scan time
 M_X, M_Y, M_E, M_H, M_V, M_DROP, M_SEEN, M_TURN, M_TIME = range(MEMORY_ROWS)
@@ -69,15 +94,18 @@ ENEMY_FEATURES = 9
 MATE_FEATURES = 5
 MAX_AGE = 50.0  # turns: older scans read as 1
 WALL_MARGIN = 18.0  # half a robot: a tank's centre never gets closer to a wall (Robocode's 36 px body)
-LEADS = {"none": 0, "linear": 1, "circular": 2}
+LEADS = {"none": 0, "linear": 1, "circular": 2, "gf": 3}
+LEAD_GF = LEADS["gf"]
+KNOWLEDGE_FEATURES = 8  # the knowledge block (tech.knowledge_row)
+KNOWLEDGE_NAMES = ("vg_head", "vg_linear", "vg_circular", "vg_gf", "waves", "wave_impact", "gf_peak", "surf_peak")
 
 
-def n_features(k: int, m: int) -> int:
-    """Length of the tank view with k enemy slots and m mate slots."""
-    return OWN_FEATURES + ENEMY_FEATURES * k + MATE_FEATURES * m
+def n_features(k: int, m: int, knowledge: bool = False) -> int:
+    """Length of the tank view with k enemy slots and m mate slots (and the knowledge block)."""
+    return OWN_FEATURES + ENEMY_FEATURES * k + MATE_FEATURES * m + (KNOWLEDGE_FEATURES if knowledge else 0)
 
 
-def feature_names(k: int, m: int) -> list[str]:
+def feature_names(k: int, m: int, knowledge: bool = False) -> list[str]:
     """Names of the tank view's entries, in order."""
     names = ["wall_left", "wall_bottom", "wall_right", "wall_top", "sin_heading", "cos_heading", "velocity",
              "energy", "gun_heat", "enemies_alive", "mates_alive"]
@@ -86,7 +114,7 @@ def feature_names(k: int, m: int) -> list[str]:
                                              "advancing", "energy", "age", "drop")]
     for s in range(m):
         names += [f"mate{s}_{n}" for n in ("present", "sin_bearing", "cos_bearing", "distance", "energy")]
-    return names
+    return names + [f"know_{n}" for n in KNOWLEDGE_NAMES] if knowledge else names
 
 
 FEATURE_NAMES = feature_names(4, 3)
@@ -104,6 +132,8 @@ class TankSpace:
     enemy_slots: int = 4  # K
     mate_slots: int = 3  # M
     leads: tuple[str, ...] = ("none", "circular")  # the lead head's choices, of LEADS
+    surf: bool = False  # the distance head's extra last entry: the body follows the brain's movement (skills)
+    knowledge: bool = False  # the knowledge block at the end of the view (skills)
 
     def __post_init__(self) -> None:
         for name in ("distances", "turns_deg", "fire_powers"):
@@ -122,11 +152,20 @@ class TankSpace:
             raise ValueError(f"tank.turn_mode must be 'target' or 'body', got {self.turn_mode!r}")
         if not self.leads or any(v not in LEADS for v in self.leads):
             raise ValueError(f"tank.leads must be a non-empty list of {', '.join(LEADS)}, got {self.leads!r}")
+        for name in ("surf", "knowledge"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"tank.{name} must be true or false, got {getattr(self, name)!r}")
+
+    @property
+    def skills(self) -> bool:
+        """True when the tank carries a technique brain (a gf lead, surf or knowledge)."""
+        return self.surf or self.knowledge or "gf" in self.leads
 
     @property
     def dims(self) -> tuple[int, int, int, int, int]:
-        """Sizes of the five action heads: distance, turn, fire, target slot, lead."""
-        return len(self.distances), len(self.turns_deg), len(self.fire_powers), self.enemy_slots, len(self.leads)
+        """Sizes of the five action heads: distance (+ surf), turn, fire, target slot, lead."""
+        return (len(self.distances) + int(self.surf), len(self.turns_deg), len(self.fire_powers), self.enemy_slots,
+                len(self.leads))
 
     @property
     def n_actions(self) -> int:
@@ -136,19 +175,21 @@ class TankSpace:
     @property
     def n_features(self) -> int:
         """Tank view length."""
-        return n_features(self.enemy_slots, self.mate_slots)
+        return n_features(self.enemy_slots, self.mate_slots, self.knowledge)
 
 
 def action_table(space: TankSpace) -> np.ndarray:
-    """(n_actions, 6) rows of (distance, body turn, fire power (-1 = hold), target slot, 1 when the turn is
-    relative to the target's bearing, the gun's lead (LEADS)) per joint action."""
+    """(n_actions, 7) rows of (distance, body turn, fire power (-1 = hold), target slot, 1 when the turn is
+    relative to the target's bearing, the gun's lead (LEADS), 1 when the body surfs (distance 0)) per joint
+    action."""
     d, t, f, k, lead = np.unravel_index(np.arange(space.n_actions), space.dims)
     power = np.asarray(space.fire_powers, dtype=np.float64)[f]
-    return np.stack([np.asarray(space.distances, dtype=np.float64)[d],
+    surf = d >= len(space.distances)
+    return np.stack([np.asarray(space.distances + (0.0,), dtype=np.float64)[d],
                      np.radians(np.asarray(space.turns_deg, dtype=np.float64))[t],
                      np.where(power > 0, power, -1.0), k.astype(np.float64),
                      np.full(d.size, 1.0 if space.turn_mode == "target" else 0.0),
-                     np.array([float(LEADS[v]) for v in space.leads])[lead]], axis=1)
+                     np.array([float(LEADS[v]) for v in space.leads])[lead], surf.astype(np.float64)], axis=1)
 
 
 @njit(cache=True, _nrt=False)  # no allocation: no reference counting of the arrays it is passed

@@ -38,8 +38,10 @@ from .kernel_cache import install
 from .rules import java_atan2, java_hypot, java_next_double, java_seed, normal_relative_angle
 from .scenarios import Scenario
 from .strictmath import strict_cos, strict_sin
+from .tank import KNOWLEDGE_FEATURES
 
-__all__ = ["TECH_ROBOTS", "TechBots", "TechState", "tech_kind", "tech_battle", "tech_battle_step", "poses_per_turn"]
+__all__ = ["TECH_ROBOTS", "TechBots", "TechState", "tech_kind", "tech_battle", "tech_battle_step", "poses_per_turn",
+           "knowledge_row", "guess_aim", "BRAIN"]
 
 G_HEAD, G_LINEAR, G_CIRCULAR, G_GF, G_VIRTUAL = range(5)
 MV_ORBIT, MV_STOPGO, MV_RAM, MV_SURF, MV_RISK = range(5)
@@ -56,6 +58,7 @@ TECH_ROBOTS: dict[str, tuple[int, int]] = {
     "SurfVG": (G_VIRTUAL, MV_SURF),
     "RiskGF": (G_GF, MV_RISK),
 }
+BRAIN = "SurfGF"  # a learning tank's technique brain (confront.arena.tank's skills)
 
 BINS, MID = 31, 15
 SEGMENTS = 5 * 3 * 3 * 3
@@ -67,7 +70,8 @@ STICK, MARGIN, SPIN = 140.0, 25.0, 10000.0
 
 # per-round memory (mem[b, i, :]): scalars, then enemy slots, enemy waves, gun waves
 T_NE, T_MOVEDIR, T_GUNDIR, T_DESTX, T_DESTY, T_DESTT, T_PREVX, T_PREVY, T_PREVH, T_PREVV, T_GNEXT, T_STARTED = range(12)
-T_ROBOT = 12  # slot -> robot index
+T_AIMSLOT, T_AIMGF, T_AIMPEAK = range(12, 15)  # the decision's GuessFactor aim (TechBrain.aimSlot, ...)
+T_ROBOT = 15  # slot -> robot index
 T_SLOT = T_ROBOT + MAXE  # robot index -> slot (-1 none); room for 16 robots
 MAX_ROBOTS = 16
 E0 = T_SLOT + MAX_ROBOTS
@@ -86,6 +90,8 @@ S_SURF = S_GF + SEGMENTS * BINS
 S_VG = S_SURF + BINS
 S_SIZE = S_VG + NGUNS
 MAX_HITS = 8
+MAX_IMPACT = 50.0  # turns: the knowledge block's wave time to impact saturates there
+assert KNOWLEDGE_FEATURES == NGUNS + 4
 
 
 def tech_kind(name: str) -> tuple[int, int]:
@@ -453,6 +459,12 @@ def _aim_and_fire(m, st, cmd, gun_kind, move_kind, t, x, y, now, energy, gun_hea
         if st[base + k] > st[base + best]:
             best = k
     guess = m[e + EB] + m[T_GUNDIR] * (best - MID) / float(MID) * mea
+    total = 0.0
+    for q in range(BINS):
+        total += st[base + q]
+    m[T_AIMSLOT] = t
+    m[T_AIMGF] = m[T_GUNDIR] * (best - MID) / float(MID)
+    m[T_AIMPEAK] = st[base + best] / total if total > 0 else 0.0
     k = int(m[T_GNEXT])
     m[T_GNEXT] = (k + 1) % MAXG
     q = G0 + k * G_SIZE
@@ -499,6 +511,7 @@ def _decide(b, i, gun_kind, move_kind, m, st, rng, mates, rf, rb, ri, bi, kf, ki
         for j in range(MAX_ROBOTS):
             m[T_SLOT + j] = -1.0
         cmd[3] = SPIN
+    m[T_AIMSLOT] = -1.0
     # events: deaths, bullets, scans (the handlers only record)
     for k in range(int(m[T_NE])):
         j = int(m[T_ROBOT + k])
@@ -591,6 +604,51 @@ def _decide(b, i, gun_kind, move_kind, m, st, rng, mates, rf, rb, ri, bi, kf, ki
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def knowledge_row(m, st, x, y, now, out, off):
+    """The tank view's knowledge block (confront.arena.tank) from a brain's memory ``m`` and battle memory ``st``
+    at (x, y) at time ``now`` into ``out[off:off + 8]`` (TechBrain.knowledge)."""
+    for q in range(NGUNS):
+        out[off + q] = st[S_VG + q]
+    n = 0
+    soonest = MAX_IMPACT
+    for k in range(MAXW):
+        q = W0 + k * W_SIZE
+        if m[q + WON] == 1.0:
+            n += 1
+            left = (java_hypot(x - m[q + WX], y - m[q + WY]) - m[q + WS] * (now - m[q + WT])) / m[q + WS]
+            soonest = min(soonest, max(left, 0.0))
+    out[off + 4] = min(n, 4) / 4.0
+    out[off + 5] = soonest / MAX_IMPACT
+    out[off + 6] = m[T_AIMPEAK]
+    top = 0.0
+    total = 0.0
+    for k in range(BINS):
+        top = max(top, st[S_SURF + k])
+        total += st[S_SURF + k]
+    out[off + 7] = top / total if total > 0 else 0.0
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def guess_aim(m, robot, power):
+    """The gun's absolute angle of the brain's GuessFactor aim at ``robot`` this turn for a bullet of ``power``:
+    its bin's factor x the escape angle from the robot's bearing; NaN when it did not aim at that robot
+    (TechBrain.guessAim)."""
+    s = int(m[T_AIMSLOT])
+    if s < 0 or int(m[T_ROBOT + s]) != robot:
+        return np.nan
+    return m[E0 + s * E_SIZE + EB] + m[T_AIMGF] * _escape(20.0 - 3.0 * power)
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
+def knowledge_kernel(on, mem, stat, x, y, time, off, feats):
+    """The knowledge blocks of the robots with a brain (``on`` (R,)) of (B, R) battles into ``feats[..., off:]``."""
+    for b in range(x.shape[0]):
+        for i in range(x.shape[1]):
+            if on[i]:
+                knowledge_row(mem[b, i], stat[b, i], x[b, i], y[b, i], float(time[b]), feats[b, i], off)
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def tech_battle_step(b, guns, moves, mem, stat, rng, mates, rf, rb, ri, bi, kf, ki, scanned, scan_order, cmd, w, h,
                      hit_p, hit_h):
     """One decision of every alive technique robot of battle b (a compiled turn loop calls it per battle). A robot
@@ -638,7 +696,10 @@ def no_tech_state(n_robots: int) -> TechState:
 class TechBots:
     """Technique robots for some robots of an Arena (all battles); battles of ``rounds_per_battle`` rounds."""
 
-    def __init__(self, arena: Arena, names: Sequence[str | None], rounds_per_battle: int = 35) -> None:
+    def __init__(self, arena: Arena, names: Sequence[str | None], rounds_per_battle: int = 35,
+                 mates: Sequence[int] | None = None) -> None:
+        """``mates``: per robot, the robots its isTeammate accepts (bit j); by default as the engine names the
+        robots of ``names`` (teammate_masks)."""
         if len(names) != arena.n_robots:
             raise ValueError(f"names has {len(names)} entries, the arena has {arena.n_robots} robots")
         if arena.n_robots > MAX_ROBOTS:
@@ -656,7 +717,8 @@ class TechBots:
         self.mem = np.zeros((nb, nr, M_SIZE))
         self.stat = np.zeros((nb, nr, S_SIZE))
         self.rng = np.zeros((nb, nr), dtype=np.int64)
-        self.mates = np.array(teammate_masks(self.names, list(arena.state.team[0])), dtype=np.int64)
+        self.mates = np.array(teammate_masks(self.names, list(arena.state.team[0])) if mates is None else mates,
+                              dtype=np.int64)
         self._round = np.zeros(nb, dtype=np.int64)
         self._hits = (np.zeros(MAX_HITS), np.zeros(MAX_HITS))
         s = arena.state
@@ -672,14 +734,10 @@ class TechBots:
         seed the generator from the start position."""
         rnd = self.arena.state.round
         changed = np.flatnonzero(rnd != self._round)
-        s = self.arena.state
         for b in changed:
             self.mem[b] = 0.0
             if (int(rnd[b]) - 1) % self.rounds_per_battle == 0:
-                self.stat[b] = 0.0
-                self.stat[b, :, S_SURF + MID] = 1.0  # before any hit: expect head-on aim
-                for i in self._bots:
-                    self.rng[b, i] = java_seed_of_start(float(s.x[b, i]), float(s.y[b, i]))
+                self._battle_start(int(b))
             self._round[b] = rnd[b]
 
     def new_battles(self, mask: np.ndarray) -> None:
@@ -705,6 +763,14 @@ class TechBots:
                 got = "missing" if saved is None else f"shape {np.shape(saved)}"
                 raise ValueError(f"technique robots' {name} is {got}, expected shape {arr.shape}")
             arr[...] = saved
+
+    def _battle_start(self, b: int) -> None:
+        """Battle b's first round: forget the battle's memory, seed the generators from the start positions."""
+        s = self.arena.state
+        self.stat[b] = 0.0
+        self.stat[b, :, S_SURF + MID] = 1.0  # before any hit: expect head-on aim
+        for i in self._bots:
+            self.rng[b, i] = java_seed_of_start(float(s.x[b, i]), float(s.y[b, i]))
 
     def commands(self, cmd: np.ndarray) -> np.ndarray:
         """Fill the technique robots' rows of ``cmd`` (B, R, 5) in place for the next turn."""

@@ -311,7 +311,8 @@ def write_robot(out: str | Path, bot: str, classes: tuple[str, ...], data: str |
         pkg = root / "confront"
         pkg.mkdir(parents=True, exist_ok=True)
         src = Path(__file__).parent / "java" / "confront"
-        for cls in classes:
+        for cls in classes:  # a name may hold a subpackage's folder ("tech/TechBrain")
+            (pkg / cls).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(compiled / "confront" / f"{cls}.class", pkg / f"{cls}.class")
             shutil.copy2(src / f"{cls}.java", pkg / f"{cls}.java")
         (pkg / f"{bot}.properties").write_text(

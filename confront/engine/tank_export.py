@@ -3,10 +3,13 @@ standalone Robocode robot ``confront.TankBot``, with its Java inference (``TankM
 :class:`TankPolicy` is the Python twin: the same view (the simulator's ``tank_view_row``, fed what the robot
 knows), the same action (greedy, or sampled from uniform draws: ``play``) and the same gun/radar controller
 (``smdp.controller_turn`` with ``tank.lead_point``: no lead, linear, or circular with the turn rate of
-``observe.remember_scans``).
+``observe.remember_scans``; gf with the technique brain's angle, ``robot_control``'s ``gun_aim``). The twin has no
+technique brain: with skills, the exported robot is checked against the simulator's battles
+(tests/engine/test_tank_skills.py).
 
 Policy file (text, data only): ``confront-tank 1``, ``key value`` lines (lists as space-separated values;
-``play sampled`` for a robot that samples its actions, greedy without it) and ``matrix NAME ROWS COLS``
+``play sampled`` for a robot that samples its actions, greedy without it; the skills ``surf 1``, ``knowledge 1``
+and the lead ``gf``, absent when off, so older files read as before) and ``matrix NAME ROWS COLS``
 blocks: ``w0 b0 w1 b1 ...``, weights as (out, in), tanh between layers, the last layer's outputs the logits
 of the five heads (distance, body turn, fire power, enemy slot, gun lead) in order.
 
@@ -34,7 +37,7 @@ import numpy as np
 from confront.arena.control import ControlConfig
 from confront.arena.observe import float_mod
 from confront.arena.rules import java_atan2, java_hypot
-from confront.arena.tank import MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
+from confront.arena.tank import KNOWLEDGE_FEATURES, MEMORY_ROWS, TankSpace, action_table, lead_point, tank_view_row
 from confront.engine.export import ROBOTS_FOLDER_HINT, ExportedPolicy, export_robot, write_robot
 from confront.engine.install import EngineInstall
 from confront.engine.java_build import MODEL_CLASSES, ROBOT_HELPERS
@@ -46,7 +49,7 @@ __all__ = ["TankPolicy", "PLAYS", "sample_heads", "robot_view", "robot_target", 
            "turn_rate", "export_tank_robot", "evaluate_tank_policy", "is_tank_run", "load_tank_policy", "TANK_CLASSES",
            "TANK_ROBOT"]
 
-TANK_CLASSES = ("TankBot", "TankModel", *MODEL_CLASSES, *ROBOT_HELPERS)
+TANK_CLASSES = ("TankBot", "TankModel", "tech/TechBrain", *MODEL_CLASSES, *ROBOT_HELPERS)
 TANK_ROBOT = "confront.TankBot 1.0"  # the exported jar's robot name
 EnemyRow = Sequence[float]  # x, y, energy, heading, velocity, energy drop, scan time, turn rate
 MAX_RATE = math.pi / 18.0  # Rules.MAX_TURN_RATE, 10 deg/turn
@@ -82,10 +85,12 @@ def sample_heads(logits: np.ndarray, dims: Sequence[int], u: Sequence[float]) ->
 
 
 def robot_view(own: Sequence[float], counts: Sequence[int], enemies: Sequence[EnemyRow], mates: Sequence[MateRow],
-               time: float, width: float, height: float, space: TankSpace) -> tuple[np.ndarray, np.ndarray]:
+               time: float, width: float, height: float, space: TankSpace,
+               knowledge: Sequence[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The tank view (float64, (F,)) and enemy slots ((K,), rows of ``enemies``, -1 empty) of one robot, from
     what TankBot knows: ``own`` = (x, y, heading, velocity, energy, gun heat), ``counts`` = (enemies alive,
-    enemies at the start, mates alive, mates at the start), the known enemies' rows and the mates' rows.
+    enemies at the start, mates alive, mates at the start), the known enemies' rows and the mates' rows, and
+    with ``space.knowledge`` its brain's knowledge block (``knowledge``, 8 values).
     Computed by the simulator's ``tank_view_row`` (self = robot 0, then the enemies, then the mates)."""
     ne, nm = len(enemies), len(mates)
     n = 1 + ne + nm
@@ -112,6 +117,8 @@ def robot_view(own: Sequence[float], counts: Sequence[int], enemies: Sequence[En
     ea, es, ma, ms = counts  # the counts TankBot has (its mates' messages may be missing at turn 0)
     out[9] = ea / es if es > 0 else 0.0
     out[10] = ma / ms if ms > 0 else 0.0
+    if space.knowledge and knowledge is not None:
+        out[-KNOWLEDGE_FEATURES:] = knowledge
     return out, np.where(slots >= 0, slots - 1, -1)
 
 
@@ -154,23 +161,24 @@ def body_turn(space: TankSpace, x: float, y: float, heading: float, enemies: Seq
 
 def robot_control(control: ControlConfig, lead: str, x: float, y: float, gun_heading: float, radar_heading: float,
                   gun_heat: float, energy: float, enemies: Sequence[EnemyRow], target: int, power: float,
-                  time: float, width: float, height: float) -> tuple[float, float, float]:
+                  time: float, width: float, height: float, gun_aim: float = math.nan) -> tuple[float, float, float]:
     """(gun turn (NaN = keep), radar turn, fire power) of the controller (smdp.controller_turn) toward
     ``enemies[target]`` with the step's ``lead`` (one of TankSpace.leads: "none", "linear", or "circular" with
-    the row's turn rate; ``lead_point``, bullet power ``power`` or 2 when not set); ``power`` -1 holds fire, 0
-    picks it by distance band."""
+    the row's turn rate; ``lead_point``, bullet power ``power`` or 2 when not set; "gf": the gun to the brain's
+    absolute angle ``gun_aim``, circular when NaN); ``power`` -1 holds fire, 0 picks it by distance band."""
     if target < 0:
         return math.nan, 2 * math.pi, 0.0
     row = enemies[target]
     tx, ty = float(row[0]), float(row[1])
-    if lead != "none":
-        rate = float(row[7]) if lead == "circular" else 0.0
+    aimed = lead == "gf" and not math.isnan(gun_aim)
+    if lead != "none" and not aimed:
+        rate = float(row[7]) if lead in ("circular", "gf") else 0.0  # gf without an aim: circular
         tx, ty = lead_point(x, y, tx, ty, float(row[3]), float(row[4]), rate, float(time - row[6]),
                             power if power > 0 else 2.0, float(width), float(height))
     dx, dy = tx - x, ty - y
     bearing = java_atan2(dx, dy)  # Math.atan2's bits, as TankModel
     dist = java_hypot(dx, dy)
-    gun = _relative(bearing - gun_heading)
+    gun = _relative((gun_aim if aimed else bearing) - gun_heading)
     radar = _relative(bearing - radar_heading)
     radar = radar + float(np.sign(radar)) * control.radar_overshoot
     shoot = abs(gun) <= control.aim_tolerance and gun_heat == 0 and energy > 0 and control.fire
@@ -283,6 +291,7 @@ class TankPolicy:
                  f"turns_deg {nums(s.turns_deg)}", f"turn_mode {s.turn_mode}",
                  f"fire_powers {nums(s.fire_powers)}", f"enemy_slots {s.enemy_slots}",
                  f"mate_slots {s.mate_slots}", f"leads {' '.join(s.leads)}"]
+        lines += [f"{name} 1" for name in ("surf", "knowledge") if getattr(s, name)]  # skills: absent when off
         if self.play != "greedy":
             lines.append(f"play {self.play}")
         for f in fields(ControlConfig):

@@ -136,7 +136,11 @@ class TankSection:
     mate_slots: int = field(3, ge=0, le=16, doc="M nearest team-mates in the view")
     leads: tuple[str, ...] = field(("none", "circular"),
                                    doc="the gun's lead, chosen per step among: none, linear, circular (turn rate "
-                                   "between scans)")
+                                   "between scans), gf (the technique brain's GuessFactor aim; a skill)")
+    surf: bool = field(False, doc="a skill: one more move choice, the body follows the technique brain's wave "
+                       "surfing (minimum risk in melee) for the step")
+    knowledge: bool = field(False, doc="a skill: the view ends with 8 features of what the technique brain knows "
+                            "about this battle (virtual-gun hit rates, enemy waves, how peaked its statistics are)")
     reward: Literal["score", "eq35"] = field("score", doc="team's Robocode score margin per turn, or Eq. 35")
 
     def __post_init__(self) -> None:
@@ -145,9 +149,9 @@ class TankSection:
                 raise ValueError(f"tank.{key} must not be empty")
         if any(p != 0 and not 0.1 <= p <= 3.0 for p in self.fire_powers):
             raise ValueError(f"tank.fire_powers = {list(self.fire_powers)} is not allowed: use 0 (hold) or 0.1..3")
-        bad = [v for v in self.leads if v not in ("none", "linear", "circular")]
+        bad = [v for v in self.leads if v not in ("none", "linear", "circular", "gf")]
         if bad:
-            raise ValueError(f"tank.leads entry {bad[0]!r} is not allowed: use none, linear or circular")
+            raise ValueError(f"tank.leads entry {bad[0]!r} is not allowed: use none, linear, circular or gf")
 
 
 @dataclass

@@ -173,7 +173,7 @@ def test_tank_actions_decode_to_the_action_table_and_bad_ones_fail() -> None:
     for (d, t, f, k, lead), row in zip(heads, table, strict=True):
         power = space.fire_powers[f]
         assert tuple(row) == (space.distances[d], np.radians(space.turns_deg[t]), power if power > 0 else -1.0,
-                              k, 1.0, LEADS[space.leads[lead]])
+                              k, 1.0, LEADS[space.leads[lead]], 0.0)
     for bad in ([1, 2, 3], [5, 0, 0, 0, 0], [0, 0, 0, 0, -1], [0.5, 0, 0, 0, 0], 3, "a"):
         with pytest.raises(ValueError, match="head indices"):
             action_indices(cfg, bad, 1)

@@ -57,7 +57,7 @@ def test_action_table_decodes_the_heads() -> None:
     space = TankSpace()
     table = action_table(space)
     a = np.ravel_multi_index((4, 0, 0, 2, 1), space.dims)
-    np.testing.assert_allclose(table[a], [150.0, math.radians(-90.0), -1.0, 2.0, 1.0, 2.0])  # hold: -1, circular: 2
+    np.testing.assert_allclose(table[a], [150.0, math.radians(-90.0), -1.0, 2.0, 1.0, 2.0, 0.0])  # hold: -1, circ.: 2
     assert table[a - 1, 5] == 0.0 and len(table) == 5 * 5 * 4 * 4 * 2
 
 

@@ -40,11 +40,17 @@ public final class Aim {
      */
     double[] toward(double x, double y, double tx, double ty, double gunHeading, double radarHeading, double gunHeat,
                     double energy, double power) {
+        return toward(x, y, tx, ty, Math.atan2(tx - x, ty - y), gunHeading, radarHeading, gunHeat, energy, power);
+    }
+
+    /** toward() with the gun turned to the absolute angle gunBearing (smdp_kernel.controller_aim). */
+    double[] toward(double x, double y, double tx, double ty, double gunBearing, double gunHeading,
+                    double radarHeading, double gunHeat, double energy, double power) {
         double dx = tx - x;
         double dy = ty - y;
         double bearing = Math.atan2(dx, dy);
         double dist = Math.hypot(dx, dy);
-        double gun = relAngle(bearing - gunHeading);
+        double gun = relAngle(gunBearing - gunHeading);
         double radar = relAngle(bearing - radarHeading);
         radar = radar + Math.signum(radar) * overshoot;
         boolean shoot = Math.abs(gun) <= tolerance && gunHeat == 0 && energy > 0 && fire;

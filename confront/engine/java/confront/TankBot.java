@@ -13,13 +13,17 @@ import java.util.LinkedHashMap;
 import java.util.Map;
 import java.util.Set;
 
+import robocode.BulletHitEvent;
 import robocode.DeathEvent;
+import robocode.HitByBulletEvent;
 import robocode.MessageEvent;
 import robocode.RobotDeathEvent;
 import robocode.RoundEndedEvent;
 import robocode.ScannedRobotEvent;
 import robocode.TeamRobot;
 import robocode.util.Utils;
+
+import confront.tech.TechBrain;
 
 /**
  * A tank policy trained with confront (PPO over the tank view and tank actions), running with no Python.
@@ -32,7 +36,14 @@ import robocode.util.Utils;
  * lead). Every turn the gun/radar controller aims at the chosen target (the nearest known enemy when that one
  * is unknown or dead), with the step's lead (none, linear or circular).
  *
- * <p>Robocode makes a new robot object each round, so the memory starts empty every round. A team-mate's
+ * <p>With skills (TankModel: surf, the lead gf, knowledge) the tank carries a technique brain
+ * (confront.tech.TechBrain, SurfGF's decisions; confront.arena.tank): every turn it is given the turn's events and
+ * decides (after the view of a decision turn is made, before any command is set); its commands are proposed, not
+ * sent: the body follows its movement during a step whose distance is surf, the gun its GuessFactor aim at the
+ * target with the lead gf, and its knowledge block ends the view. The tank's controller drives the radar.
+ *
+ * <p>Robocode makes a new robot object each round, so the memory starts empty every round (the brain's battle
+ * memory lives in TechBrain's static fields: one class load per battle). A team-mate's
  * broadcast arrives one turn later, so mates are seen as they were a turn ago (and not at all at turn 0).
  *
  * <p>Training in the engine (confront.train.ppo_engine; needs -DNOSECURITY=true): the JVM property
@@ -54,8 +65,16 @@ public class TankBot extends TeamRobot {
     private final Set<String> heard = new HashSet<>();  // names that sent us a message: team-mates
     private int decisions;
     private int shots;
+    private long turns;  // turns played this round, and the time spent deciding them (ns): total, the first turn's
+    private long busyNs;  // (Robocode gives it 10 times the time) and the longest of the others
+    private long firstNs;
+    private long longestNs;
+    private int slowTurns;  // turns that took over 1 ms
+    private long longestAt;  // the turn (getTime()) of the longest
     private OutputStream log;  // the decision log of this round (confront.tank.log), opened at the first decision
     private boolean detail;
+    private TechBrain brain;  // the technique brain of a tank with skills (null without)
+    private boolean dead;  // set by onDeath: the brain decides nothing more
 
     @Override
     public void run() {
@@ -77,8 +96,14 @@ public class TankBot extends TeamRobot {
         String chosen = null;
         double power = -1.0;
         int lead = TankModel.LEAD_NONE;
+        boolean surfing = false;
+        if (model.skills()) {
+            TechBrain.startBattle(getX(), getY());
+            brain();
+        }
         long next = 0;  // the next decision turn: 0, step, 2 step, ... (a skipped decision turn is made up at once)
         while (true) {
+            long started = System.nanoTime();
             try {
                 broadcast();
                 String[] names = enemies.keySet().toArray(new String[0]);
@@ -92,7 +117,8 @@ public class TankBot extends TeamRobot {
                     double[] v = model.view(getX(), getY(), getHeadingRadians(), getVelocity(), getEnergy(),
                             getGunHeat(), Math.max(getOthers() - matesAlive, 0), enemiesStart, matesAlive,
                             matesStart, known, mates.values().toArray(new double[0][]), time,
-                            getBattleFieldWidth(), getBattleFieldHeight(), slots);
+                            getBattleFieldWidth(), getBattleFieldHeight(), slots,
+                            brain != null ? brain.knowledge(getX(), getY(), getTime()) : null);
                     double[] u = model.sampled() ? draws(model.dims().length) : new double[0];
                     int joint = model.sampled() ? model.sample(v, u) : model.act(v);
                     if (logDir != null) {
@@ -101,6 +127,7 @@ public class TankBot extends TeamRobot {
                     a = model.decode(joint);
                     power = a[2];
                     lead = (int) a[4];
+                    surfing = a[5] > 0;
                     int k = (int) a[3];
                     chosen = slots[k] >= 0 ? names[slots[k]] : null;
                     decisions++;
@@ -112,19 +139,47 @@ public class TankBot extends TeamRobot {
                     }
                 }
                 int tgt = TankModel.target(getX(), getY(), known, c);
-                if (decide) {
+                boolean thinks = brain != null && !dead;
+                if (thinks) {  // the brain's turn, on the robot's state before any command of this turn
+                    brain.decide(getTime(), getX(), getY(), getHeadingRadians(), getVelocity(), getEnergy(),
+                            getGunHeadingRadians(), getGunHeat(), getGunTurnRemainingRadians(),
+                            getRadarHeadingRadians(), getRadarTurnRemainingRadians(), getOthers());
+                }
+                if (thinks && surfing) {  // the body follows the brain every turn of the step
+                    if (!Double.isNaN(brain.cmd[0])) {
+                        setAhead(brain.cmd[0]);
+                    }
+                    if (!Double.isNaN(brain.cmd[1])) {
+                        setTurnRightRadians(brain.cmd[1]);
+                    }
+                } else if (decide) {
                     setAhead(a[0]);
                     setTurnRightRadians(model.bodyTurn(getX(), getY(), getHeadingRadians(), known, tgt, a[1]));
                 }
+                double gunAim = thinks && lead == TankModel.LEAD_GF && tgt >= 0
+                        ? brain.guessAim(brain.slotOf(names[tgt]), power > 0 ? power : 2.0) : Double.NaN;
                 if (RobotParts.command(this, model.control(getX(), getY(), getGunHeadingRadians(),
-                        getRadarHeadingRadians(), getGunHeat(), getEnergy(), known, tgt, power, lead, time,
+                        getRadarHeadingRadians(), getGunHeat(), getEnergy(), known, tgt, power, lead, gunAim, time,
                         getBattleFieldWidth(), getBattleFieldHeight()))) {
                     shots++;
+                }
+                if (brain != null) {
+                    brain.endTurn();
                 }
             } catch (RuntimeException e) {
                 out.println("CONFRONT tank-error " + e);
                 throw e;
             }
+            long spent = System.nanoTime() - started;
+            turns++;
+            busyNs += spent;
+            if (turns == 1) {
+                firstNs = spent;
+            } else if (spent > longestNs) {
+                longestNs = spent;
+                longestAt = getTime();
+            }
+            slowTurns += spent > 1_000_000L ? 1 : 0;
             execute();
         }
     }
@@ -231,12 +286,39 @@ public class TankBot extends TeamRobot {
         }
     }
 
+    /** The technique brain of this round (a tank with skills). */
+    private TechBrain brain() {
+        if (brain == null) {
+            brain = new TechBrain(TechBrain.G_GF, TechBrain.M_SURF, getBattleFieldWidth(), getBattleFieldHeight());
+        }
+        return brain;
+    }
+
     @Override
     public void onScannedRobot(ScannedRobotEvent e) {
         try {
+            if (brain != null) {
+                brain.onScanned(e.getName(), e.getBearingRadians(), e.getDistance(), e.getHeadingRadians(),
+                        e.getVelocity(), e.getEnergy(), getTime(), mate(e.getName()), getX(), getY(),
+                        getHeadingRadians());
+            }
             remember(e);
         } catch (RuntimeException x) {
             out.println("CONFRONT tank-error scan " + x);
+        }
+    }
+
+    @Override
+    public void onHitByBullet(HitByBulletEvent e) {
+        if (brain != null) {
+            brain.onHitByBullet(e.getBullet().getPower(), e.getBullet().getHeadingRadians());
+        }
+    }
+
+    @Override
+    public void onBulletHit(BulletHitEvent e) {
+        if (brain != null) {
+            brain.onBulletHit(e.getBullet().getPower());
         }
     }
 
@@ -278,6 +360,9 @@ public class TankBot extends TeamRobot {
     @Override
     public void onRobotDeath(RobotDeathEvent e) {
         String name = e.getName();
+        if (brain != null) {
+            brain.onRobotDeath(name);
+        }
         enemies.remove(name);
         if (mate(name)) {
             mates.remove(name);
@@ -287,12 +372,16 @@ public class TankBot extends TeamRobot {
 
     @Override
     public void onDeath(DeathEvent e) {
+        dead = true;
         closeLog();
     }
 
     @Override
     public void onRoundEnded(RoundEndedEvent e) {
         closeLog();
-        out.println("CONFRONT tank-round decisions=" + decisions + " shots=" + shots);
+        out.println("CONFRONT tank-round decisions=" + decisions + " shots=" + shots + " turn_us_mean="
+                + (turns > 0 ? busyNs / turns / 1000 : 0) + " first_turn_us=" + firstNs / 1000 + " turn_us_max=" + longestNs / 1000 + " at_turn=" + longestAt
+                + " turns_over_1ms="
+                + slowTurns + " turns=" + turns);
     }
 }

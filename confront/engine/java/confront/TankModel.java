@@ -10,6 +10,10 @@ import java.io.Reader;
  * the lead of confront.arena.tank.lead_point (none, linear or circular).
  * Mirrors confront.engine.tank_export.TankPolicy; the file format is written by its to_text().
  *
+ * <p>Skills (opt-in keys, absent in older files: off): "surf 1" (the distance head's extra last entry: the body
+ * follows the technique brain's movement), the lead "gf" (the brain's GuessFactor aim), "knowledge 1" (the brain's
+ * knowledge block at the end of the view); see confront.arena.tank and TankBot.
+ *
  * <p>Angles follow Robocode: radians, 0 = north (+y), clockwise. Enemy rows are {x, y, energy, heading,
  * velocity, energy drop, scan time, turn rate} of the last scan this round (turnRate: see turnRate()); mate rows
  * are {x, y, energy}.
@@ -24,6 +28,8 @@ public final class TankModel {
     static final int LEAD_NONE = 0;
     static final int LEAD_LINEAR = 1;
     static final int LEAD_CIRCULAR = 2;
+    static final int LEAD_GF = 3;
+    static final int KNOWLEDGE = 8;  // TechBrain.KNOWLEDGE
 
     final Mlp actor;
     final Aim aim;
@@ -36,6 +42,8 @@ public final class TankModel {
     final int[] leads;  // the lead head's choices: LEAD_NONE, LEAD_LINEAR, LEAD_CIRCULAR
     final boolean turnToTarget;  // turn_mode target: the body turn is an angle to the target's bearing
     final boolean sampled;  // "play sampled": act draws each head from its softmax (sample), else greedy (act)
+    final boolean surf;  // the distance head's extra last entry: the body follows the brain's movement
+    final boolean knowledge;  // the view ends with the brain's knowledge block
 
     private TankModel(ModelFile f) throws IOException {
         distances = f.list("distances");
@@ -56,6 +64,8 @@ public final class TankModel {
         }
         aim = new Aim(f);
         sampled = "sampled".equals(f.choice("play", "greedy", "greedy", "sampled"));
+        surf = "1".equals(f.choice("surf", "0", "0", "1"));
+        knowledge = "1".equals(f.choice("knowledge", "0", "0", "1"));
         actor = f.mlp("tanh", "linear", 0.0, 0.0);
         f.allTaken();
         int heads = 0;
@@ -70,7 +80,8 @@ public final class TankModel {
             case "none": return LEAD_NONE;
             case "linear": return LEAD_LINEAR;
             case "circular": return LEAD_CIRCULAR;
-            default: throw new IOException("leads must be none, linear or circular, got " + name);
+            case "gf": return LEAD_GF;
+            default: throw new IOException("leads must be none, linear, circular or gf, got " + name);
         }
     }
 
@@ -83,14 +94,39 @@ public final class TankModel {
         return stepTurns;
     }
 
-    /** Tank view length: 11 + 9 K + 5 M. */
+    /** Tank view length: 11 + 9 K + 5 M (+ 8 with knowledge). */
     public int nFeatures() {
-        return OWN + ENEMY * enemySlots + MATE * mateSlots;
+        return OWN + ENEMY * enemySlots + MATE * mateSlots + (knowledge ? KNOWLEDGE : 0);
     }
 
-    /** Sizes of the five heads: distance, turn, fire power, enemy slot, lead. */
+    /** Sizes of the five heads: distance (+ surf), turn, fire power, enemy slot, lead. */
     public int[] dims() {
-        return new int[] {distances.length, turns.length, powers.length, enemySlots, leads.length};
+        return new int[] {distances.length + (surf ? 1 : 0), turns.length, powers.length, enemySlots, leads.length};
+    }
+
+    /** Whether the tank carries a technique brain (a gf lead, surf or knowledge). */
+    public boolean skills() {
+        if (surf || knowledge) {
+            return true;
+        }
+        for (int l : leads) {
+            if (l == LEAD_GF) {
+                return true;
+            }
+        }
+        return false;
+    }
+
+    /** The view with the brain's knowledge block (TechBrain.knowledge) at its end (knowledge null: left 0). */
+    public double[] view(double x, double y, double heading, double velocity, double energy, double gunHeat,
+                         int enemiesAlive, int enemiesStart, int matesAlive, int matesStart, double[][] enemies,
+                         double[][] mates, double time, double width, double height, int[] slots, double[] known) {
+        double[] out = view(x, y, heading, velocity, energy, gunHeat, enemiesAlive, enemiesStart, matesAlive,
+                matesStart, enemies, mates, time, width, height, slots);
+        if (knowledge && known != null) {
+            System.arraycopy(known, 0, out, out.length - KNOWLEDGE, KNOWLEDGE);
+        }
+        return out;
     }
 
     /**
@@ -249,8 +285,8 @@ public final class TankModel {
     }
 
     /**
-     * (distance, body turn rad, fire power (-1 = hold), enemy slot, lead (LEAD_*)) of a joint action
-     * (action_table; the body turn as given, see bodyTurn).
+     * (distance, body turn rad, fire power (-1 = hold), enemy slot, lead (LEAD_*), 1 = the body surfs (distance
+     * 0)) of a joint action (action_table; the body turn as given, see bodyTurn).
      */
     public double[] decode(int action) {
         int[] d = dims();
@@ -261,7 +297,9 @@ public final class TankModel {
             rest /= d[head];
         }
         double p = powers[idx[2]];
-        return new double[] {distances[idx[0]], turns[idx[1]], p > 0 ? p : -1.0, idx[3], leads[idx[4]]};
+        boolean surfs = idx[0] >= distances.length;
+        return new double[] {surfs ? 0.0 : distances[idx[0]], turns[idx[1]], p > 0 ? p : -1.0, idx[3], leads[idx[4]],
+                surfs ? 1.0 : 0.0};
     }
 
     /**
@@ -335,14 +373,28 @@ public final class TankModel {
     public double[] control(double x, double y, double gunHeading, double radarHeading, double gunHeat,
                             double energy, double[][] enemies, int tgt, double power, int lead, double time,
                             double width, double height) {
+        return control(x, y, gunHeading, radarHeading, gunHeat, energy, enemies, tgt, power, lead, Double.NaN, time,
+                width, height);
+    }
+
+    /**
+     * control() with the lead gf: {@code gunAim} is the brain's GuessFactor angle for the target (absolute, NaN:
+     * none this turn: then circular).
+     */
+    public double[] control(double x, double y, double gunHeading, double radarHeading, double gunHeat,
+                            double energy, double[][] enemies, int tgt, double power, int lead, double gunAim,
+                            double time, double width, double height) {
         if (tgt < 0) {
             return Aim.none();
         }
         double[] e = enemies[tgt];
+        if (lead == LEAD_GF && !Double.isNaN(gunAim)) {
+            return aim.toward(x, y, e[0], e[1], gunAim, gunHeading, radarHeading, gunHeat, energy, power);
+        }
         double tx = e[0];
         double ty = e[1];
         if (lead != LEAD_NONE) {
-            double rate = lead == LEAD_CIRCULAR ? e[7] : 0.0;
+            double rate = lead == LEAD_CIRCULAR || lead == LEAD_GF ? e[7] : 0.0;  // gf without an aim: circular
             double[] p = leadPoint(x, y, tx, ty, e[3], e[4], rate, time - e[6], power > 0 ? power : 2.0, width,
                     height);
             tx = p[0];

@@ -302,3 +302,28 @@ def test_share_by_opponent_figure_counts_windows_of_rounds(tmp_path: Path, monke
                                    "train.session_rounds=10", "train.checkpoint_every=20"])
     train_run(cfg, tmp_path / "run", progress=False)
     assert drawn["share_by_opponent.png"] == "window of 10 rounds" and drawn["score_ratio.png"] == "session"
+
+
+def test_a_run_training_in_a_folder_keeps_it_from_a_second_train_run(runs: Path, tmp_path: Path) -> None:
+    """Item 2 as the issue reproduced it: one ``train_run`` is training in a pre-made folder (paused inside its
+    first step); a second ``train_run`` into it (exist_ok, as with a pre-made empty --out) is refused, and so is
+    ``confront train --out`` and ``--resume``; the first run's files stay as they were."""
+    busy = tmp_path / "busy"
+    busy.mkdir()
+    code = ("import sys, time; from pathlib import Path\n"
+            "from confront.train.factory import train_run\nfrom confront.train.spec import load_experiment\n"
+            "from confront.train.paper_sim import SMDPTrainer\n"
+            "def paused(self, *args):\n    print('training', flush=True)\n    time.sleep(120)\n"
+            "SMDPTrainer.advance = paused\n"
+            "train_run(load_experiment('demo', sys.argv[2:]), Path(sys.argv[1]), exist_ok=True, progress=False)\n")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(busy), *PAPER], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "training"
+        before = _snapshot(busy)
+        with pytest.raises(FileExistsError, match=f"being written by another run \\(process {proc.pid}\\)"):
+            train_run(load_experiment("demo", PAPER), busy, exist_ok=True, progress=False)
+        _one_line_exit_2(["train", "--resume", str(busy), "--quiet"], "being written by another run")
+        assert _snapshot(busy) == before and proc.poll() is None
+    finally:
+        proc.kill()
+        proc.wait()

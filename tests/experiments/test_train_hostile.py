@@ -257,8 +257,9 @@ def _nan(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 @pytest.mark.parametrize(("name", "edit", "expect"), [
     ("all-NaN", _nan, "cannot be read: its arrays net.actor.0.weight, net.actor.0.bias, net.actor.2.weight, "
                       "net.actor.2.bias, net.actor.4.weight hold NaN or infinite values"),
-    ("a wrong-size array", lambda s: {**s, "net.actor.0.weight": s["net.actor.0.weight"][:, :7]},
-     "cannot be read: "),
+    ("a wrong-size weight", lambda s: {**s, "net.actor.0.weight": s["net.actor.0.weight"][:, :7]},
+     "cannot be read: network does not fit: Error(s) in loading state_dict for ActorCritic:"),
+    ("a wrong-size generator state", lambda s: {**s, "gen": s["gen"][:100]}, "cannot be read: "),
 ])
 def test_an_edited_ppo_npz_is_refused_by_evaluate(runs: Path, tmp_path: Path, name: str, edit: Any,
                                                    expect: str) -> None:

@@ -200,7 +200,8 @@ class TankTrainer:
             self.ppo.load_state_dict(sub("ppo."))
             n_snaps = int(meta["snapshots"])
             held = {k.split(".", 1)[0] for k in arrays if k.startswith("snap")}
-            if held != {f"snap{i}" for i in range(n_snaps)}:  # snapshots = 10**8 would loop for hours
+            # the count first: the set of 10**8 names alone would take GBs (the snapshots' loop, hours)
+            if n_snaps != len(held) or held != {f"snap{i}" for i in range(n_snaps)}:
                 raise ValueError(f"snapshots = {n_snaps} but it holds {len(held)} snapshot(s)")
             self.snapshots = [sub(f"snap{i}.") for i in range(n_snaps)]
             actor = {k: (v.shape, v.dtype.kind) for k, v in self.ppo.actor_arrays().items()}

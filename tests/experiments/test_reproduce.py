@@ -170,3 +170,21 @@ def test_committed_claims_are_restated_from_their_numbers() -> None:
     assert restate_claim({**level, "ours": "FLM 0.41 [0.38, 0.43]"}, 10).verdict == "no"
     new = restate_claim(c.__dict__, 10)
     assert new == c
+
+
+@pytest.mark.parametrize("args", [["--rounds", "0"], ["--rounds", "-5"], ["--workers", "0"], ["--workers", "-3"]])
+def test_reproduce_refuses_bad_rounds_and_workers_before_starting(args: list[str], tmp_path: Path,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 34 item 19: ``reproduce migration --rounds 0/-5`` and ``--workers 0/-3`` were accepted silently."""
+    from click.testing import CliRunner
+
+    from confront.cli.main import cli
+
+    started: list[dict] = []
+    monkeypatch.setattr("confront.experiments.reproduce.reproduce_cli", lambda *a, **kw: started.append(kw))
+    res = CliRunner().invoke(cli, ["reproduce", "migration", *args, "--out", str(tmp_path / "out")])
+    assert res.exit_code == 2 and started == [], (res.output, started)
+    bound = "1<=x<=2147483647" if args[0] == "--rounds" else "x>=1"  # rounds: Robocode's Java int
+    assert res.stderr == (f"error: Invalid value for '{args[0]}': {args[1]} is not in the range {bound}. "
+                          "(see `cli reproduce --help`)\n"), res.stderr
+    assert not (tmp_path / "out").exists()

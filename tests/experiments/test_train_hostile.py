@@ -234,3 +234,97 @@ def test_demo_hints_name_the_command_as_started_and_the_replay(tmp_path: Path,
     assert f"open {replay.parent / 'last_round.html'}" in res.output
     assert f".venv/bin/confront evaluate {tmp_path / 'run'} --rounds 100" in res.output
     assert "  confront " not in res.output
+
+
+def test_a_linked_figure_is_replaced_on_resume_not_followed(runs: Path, tmp_path: Path) -> None:
+    """Item 3: a symlinked ``plots/score_ratio.png`` had its target overwritten by ``--resume``."""
+    run = _killed(runs, "paper", tmp_path / "run")
+    target = tmp_path / "precious.png"
+    target.write_bytes(b"keep")
+    (run / "plots" / "score_ratio.png").unlink()
+    (run / "plots" / "score_ratio.png").symlink_to(target)
+    res = CliRunner().invoke(cli, ["train", "--resume", str(run), "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert target.read_bytes() == b"keep"
+    figure = run / "plots" / "score_ratio.png"
+    assert not figure.is_symlink() and figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def _nan(state: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    return {k: np.full_like(v, np.nan) if v.dtype.kind == "f" else v for k, v in state.items()}
+
+
+@pytest.mark.parametrize(("name", "edit", "expect"), [
+    ("all-NaN", _nan, "cannot be read: its arrays net.actor.0.weight, net.actor.0.bias, net.actor.2.weight, "
+                      "net.actor.2.bias, net.actor.4.weight hold NaN or infinite values"),
+    ("a wrong-size weight", lambda s: {**s, "net.actor.0.weight": s["net.actor.0.weight"][:, :7]},
+     "cannot be read: network does not fit: Error(s) in loading state_dict for ActorCritic:"),
+    ("a wrong-size generator state", lambda s: {**s, "gen": s["gen"][:100]}, "cannot be read: "),
+])
+def test_an_edited_ppo_npz_is_refused_by_evaluate(runs: Path, tmp_path: Path, name: str, edit: Any,
+                                                   expect: str) -> None:
+    """Items 6, 7: an all-NaN ``ppo.npz`` was scored; a wrong-size array in it was a traceback."""
+    run = tmp_path / "run"
+    shutil.copytree(runs / "ppo", run)
+    path = run / "model" / "ppo.npz"
+    with np.load(path, allow_pickle=False) as z:
+        state = {k: z[k] for k in z.files}
+    with path.open("wb") as fh:
+        np.savez(fh, **edit(state))
+    before = _snapshot(run)
+    _one_line_exit_2(["evaluate", str(run), "--rounds", "2"], f"error: model {run / 'model'} {expect}")
+    assert _snapshot(run) == before
+
+
+def test_engine_evaluate_names_its_table_as_the_simulators(runs: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Friction: the engine's table said "score ratio (robocode)", the simulator's "score share", unexplained."""
+    monkeypatch.setattr("confront.engine.tank_export.evaluate_tank_policy",
+                        lambda policy, scen, opp, rounds, seed, visible=False: (None, 0.25))
+    res = CliRunner().invoke(cli, ["evaluate", str(runs / "ppo"), "--engine", "robocode", "--rounds", "2",
+                                   "--opponents", "1v1:SpinBot"])
+    assert res.exit_code == 0, (res.output, res.exception)
+    assert "| opponent | battles | score share (robocode) |" in res.output and "0.5 is even" in res.output
+    assert "| 1v1:SpinBot | 1 | 0.250 |" in res.output and "score ratio" not in res.output
+
+
+def test_share_by_opponent_figure_counts_windows_of_rounds(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Friction: the per-opponent figure's x axis said "session" but counted 10-round windows."""
+    import confront.plots
+
+    drawn: dict[str, str] = {}
+    plot_curves = confront.plots.plot_curves
+
+    def recorded(curves: Any, path: Any, **kw: Any) -> Path:
+        drawn[Path(path).name] = kw.get("xlabel", "session")
+        return plot_curves(curves, path, **kw)
+
+    monkeypatch.setattr(confront.plots, "plot_curves", recorded)
+    cfg = load_experiment("demo", [*PPO[:1], 'league.opponents=["1v1:SpinBot"]', *PPO[2:5], "train.rounds=20",
+                                   "train.session_rounds=10", "train.checkpoint_every=20"])
+    train_run(cfg, tmp_path / "run", progress=False)
+    assert drawn["share_by_opponent.png"] == "window of 10 rounds" and drawn["score_ratio.png"] == "session"
+
+
+def test_a_run_training_in_a_folder_keeps_it_from_a_second_train_run(runs: Path, tmp_path: Path) -> None:
+    """Item 2 as the issue reproduced it: one ``train_run`` is training in a pre-made folder (paused inside its
+    first step); a second ``train_run`` into it (exist_ok, as with a pre-made empty --out) is refused, and so is
+    ``confront train --out`` and ``--resume``; the first run's files stay as they were."""
+    busy = tmp_path / "busy"
+    busy.mkdir()
+    code = ("import sys, time; from pathlib import Path\n"
+            "from confront.train.factory import train_run\nfrom confront.train.spec import load_experiment\n"
+            "from confront.train.paper_sim import SMDPTrainer\n"
+            "def paused(self, *args):\n    print('training', flush=True)\n    time.sleep(120)\n"
+            "SMDPTrainer.advance = paused\n"
+            "train_run(load_experiment('demo', sys.argv[2:]), Path(sys.argv[1]), exist_ok=True, progress=False)\n")
+    proc = subprocess.Popen([sys.executable, "-c", code, str(busy), *PAPER], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == "training"
+        before = _snapshot(busy)
+        with pytest.raises(FileExistsError, match=f"being written by another run \\(process {proc.pid}\\)"):
+            train_run(load_experiment("demo", PAPER), busy, exist_ok=True, progress=False)
+        _one_line_exit_2(["train", "--resume", str(busy), "--quiet"], "being written by another run")
+        assert _snapshot(busy) == before and proc.poll() is None
+    finally:
+        proc.kill()
+        proc.wait()

@@ -102,6 +102,22 @@ def test_training_against_sittingduck_learns(tmp_path, overlap: str) -> None:
     assert before["win_rate"] <= after["win_rate"]
 
 
+def test_training_with_skills_against_a_technique_robot_raises_its_share(tmp_path) -> None:
+    # RamHeadOn (ramming, head-on gun, battle memory over 35-round battles): the tank with the skills (gf lead,
+    # surf, the knowledge block) starts near 0.3 and must learn to keep away and hit it within 300 rounds
+    cfg = _cfg(tmp_path, "1v1:RamHeadOn", **{"league.battles": "16", "train.rounds": "300", "ppo.lr": "0.002",
+                                             "tank.leads": '["none","gf"]', "tank.surf": "true",
+                                             "tank.knowledge": "true"})
+    trainer = TankTrainer(cfg)
+    before = evaluate_tanks(cfg, trainer.ppo, rounds=16)["1v1:RamHeadOn"]["share"]
+    while trainer.rounds_done < 300:
+        trainer.update()
+    after = evaluate_tanks(cfg, trainer.ppo, rounds=16)["1v1:RamHeadOn"]["share"]
+    share = [r["score_ours"] / max(r["score_ours"] + r["score_theirs"], 1e-9) for r in trainer.rows]
+    assert after > 0.6 and after > before + 0.3
+    assert np.mean(share[-32:]) > np.mean(share[:32]) + 0.2  # it rose in training too, not only greedily
+
+
 @pytest.mark.parametrize(("overlap", "prioritise"), [("false", "false"), ("true", "false"), ("false", "true")])
 def test_resume_after_a_kill_is_exact(tmp_path, overlap: str, prioritise: str) -> None:
     cfg = _cfg(tmp_path, "1v1:SpinBot,4v4:dodge", ckpt="6", **{"league.battles": "2", "train.rounds": "14",

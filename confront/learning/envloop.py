@@ -19,16 +19,8 @@ def _row(obs: Any, learner: Learner) -> np.ndarray:
     return np.asarray(obs, dtype=np.float64).reshape(1, -1)
 
 
-def run_episodes(
-    env: Any,
-    learner: Learner,
-    rng: np.random.Generator,
-    episodes: int,
-    sojourn: int = 1,
-    learn: bool = True,
-    explore: bool = True,
-    max_steps: int = 10_000,
-) -> np.ndarray:
+def run_episodes(env: Any, learner: Learner, rng: np.random.Generator, episodes: int, sojourn: int = 1,
+                 learn: bool = True, explore: bool = True, max_steps: int = 10_000) -> np.ndarray:
     """Play ``episodes`` episodes, holding each action for ``sojourn`` env steps (one SMDP step) and learning
     from every SMDP step when ``learn``; returns each episode's undiscounted return.
 
@@ -60,16 +52,8 @@ def run_episodes(
     return returns
 
 
-def run_parallel_episodes(
-    env: Any,
-    learner: Learner,
-    rng: np.random.Generator,
-    episodes: int,
-    sojourn: int = 1,
-    learn: bool = True,
-    explore: bool = True,
-    max_steps: int = 10_000,
-) -> np.ndarray:
+def run_parallel_episodes(env: Any, learner: Learner, rng: np.random.Generator, episodes: int, sojourn: int = 1,
+                          learn: bool = True, explore: bool = True, max_steps: int = 10_000) -> np.ndarray:
     """Like :func:`run_episodes` for a PettingZoo ``ParallelEnv``: all live agents act through ``learner`` and
     their SMDP transitions form one batch per step (parameter sharing). Returns the team's summed return per
     episode. An agent that ends inside a held step keeps its last observation and is marked done."""

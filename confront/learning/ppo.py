@@ -211,7 +211,8 @@ class PPO:
 
     kind = "ppo"
 
-    def __init__(self, n_features: int, dims: tuple[int, ...], config: PPOConfig | None = None, seed: int = 0) -> None:
+    def __init__(self, n_features: int, dims: tuple[int, ...], config: PPOConfig | None = None, seed: int = 0,
+                 init_logits: np.ndarray | None = None) -> None:
         self.config = config or PPOConfig()
         # acting runs between simulator steps on one thread; the update of the sequential schedule has the cores
         # to itself (:meth:`_learn` widens to ``threads``); with ``overlap`` both run beside the env at ``threads``
@@ -223,6 +224,11 @@ class PPO:
         torch.manual_seed(seed)
         self.net = ActorCritic(n_features, dims, self.config.hidden, self.config.team_critic,
                                self.config.critic_hidden)
+        if init_logits is not None:  # a prior over the choices: added to the output layer's (zero) biases
+            if np.shape(init_logits) != (sum(dims),) or not np.all(np.isfinite(init_logits)):
+                raise ValueError(f"init_logits must be {sum(dims)} finite numbers, got shape {np.shape(init_logits)}")
+            with torch.no_grad():
+                self.net.actor[-1].bias.add_(torch.from_numpy(np.asarray(init_logits, dtype=np.float32)))
         self.opt = torch.optim.Adam(self.net.parameters(), lr=self.config.lr, eps=1e-5)
         self.gen = torch.Generator().manual_seed(seed)  # minibatch order
         self.act_gen = torch.Generator().manual_seed(seed + 1)  # action sampling (its own stream: acting and

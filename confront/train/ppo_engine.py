@@ -141,7 +141,8 @@ class EngineTankTrainer:
         self.cfg, self.run = cfg, run
         self.cpu_constant_ms = TANK_CPU_CONSTANT_MS if cpu_constant_ms is None else cpu_constant_ms
         self.space = tank_space(cfg)
-        self.ppo = PPO(self.space.n_features, self.space.dims, cfg.ppo, seed=cfg.train.seed)
+        self.ppo = PPO(self.space.n_features, self.space.dims, cfg.ppo, seed=cfg.train.seed,
+                       init_logits=self.space.skill_logits(cfg.tank.skill_prior))
         self.info: dict[str, Any] = {}
         if cfg.train.init:
             self.ppo.load_state_dict(load_tank_model(cfg.train.init, cfg).state_dict())

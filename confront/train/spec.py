@@ -141,6 +141,9 @@ class TankSection:
                        "surfing (minimum risk in melee) for the step")
     knowledge: bool = field(False, doc="a skill: the view ends with 8 features of what the technique brain knows "
                             "about this battle (virtual-gun hit rates, enemy waves, how peaked its statistics are)")
+    skill_prior: float = field(0.0, ge=0.0, le=10.0, doc="the untrained policy's logit bonus for the skills' "
+                               "choices (surf, the gf lead): at 3 it surfs and aims by GuessFactor 80% of the time "
+                               "and learns when not to; 0: every choice alike")
     reward: Literal["score", "eq35"] = field("score", doc="team's Robocode score margin per turn, or Eq. 35")
 
     def __post_init__(self) -> None:

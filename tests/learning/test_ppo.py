@@ -1,5 +1,7 @@
 """PPO: GAE by hand, the factorised joint action, the team critic's input, learning a known problem, state."""
 
+import math
+
 import numpy as np
 import pytest
 import torch
@@ -260,3 +262,25 @@ def test_thread_pools_spin_briefly_unless_the_user_says_otherwise(var: str, give
     code = f"import confront, os; print(os.environ.get({var!r}, 'unset'))"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.strip() == want
+
+
+def test_skill_prior_sets_the_untrained_policys_probabilities() -> None:
+    from confront.arena.tank import TankSpace
+
+    space = TankSpace(leads=("none", "linear", "circular", "gf"), surf=True)
+    logits = space.skill_logits(3.0)
+    assert logits.tolist() == [0] * 5 + [3] + [0] * 16 + [3]  # surf ends the distance head, gf the lead head
+    assert not TankSpace().skill_logits(3.0).any()  # no skill: no prior
+    obs = np.random.default_rng(0).normal(size=(4096, space.n_features)).astype(np.float32)
+    ppo = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=logits)
+    _, heads, _ = ppo.act(obs)
+    surf, gf = (heads[:, 0] == 5).mean(), (heads[:, 4] == 3).mean()
+    want = math.exp(3) / (math.exp(3) + 5), math.exp(3) / (math.exp(3) + 3)  # 0.801, 0.870 (other logits ~0)
+    assert abs(surf - want[0]) < 0.03 and abs(gf - want[1]) < 0.03
+    assert abs((heads[:, 2] == 0).mean() - 0.25) < 0.03  # the fire head untouched
+    plain = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1)
+    same = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=space.skill_logits(0.0))
+    for a, b in zip(plain.state_dict().values(), same.state_dict().values(), strict=True):
+        np.testing.assert_array_equal(a, b)  # a zero prior changes no bit
+    with pytest.raises(ValueError, match="init_logits"):
+        PPO(space.n_features, space.dims, PPOConfig(hidden=32), init_logits=np.full(sum(space.dims), np.nan))

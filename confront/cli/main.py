@@ -128,10 +128,15 @@ def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, co
 @click.option("--init", "init", type=click.Path(path_type=Path, exists=True, file_okay=False), default=None,
               help="PPO: start from this run's model (model/ppo.npz), e.g. fine-tune a simulator run with "
                    "--engine robocode (train.init).")
+@click.option("--address", default=None, metavar="ray://HOST:PORT|HOST:PORT|auto",
+              help="PPO: collect the rollouts on Ray actors of this cluster (one learner here; "
+                   "docs/learning.md, \"Scale-out on Ray\").")
+@click.option("--workers", type=COUNT, default=None,
+              help="With --address: rollout workers, one CPU each (default 1; a resumed run keeps its own).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @set_option
 def train(config: str, out: Path | None, resume: Path | None, seed: int | None, engine: str, init: Path | None,
-          quiet: bool, overrides: tuple[str, ...]) -> None:
+          address: str | None, workers: int | None, quiet: bool, overrides: tuple[str, ...]) -> None:
     """Train one arm of an experiment; --resume RUN continues a killed run from its latest checkpoint."""
     from confront.train.factory import train_run
     from confront.train.loop import print_summary
@@ -146,13 +151,14 @@ def train(config: str, out: Path | None, resume: Path | None, seed: int | None, 
             raise click.UsageError(f"--resume continues {resume} with its own config and folder: drop "
                                    f"{', '.join(given)} (or start a new run without --resume)")
     if resume is not None:
-        summary = train_run(None, resume, resume=True, progress=not quiet, engine=engine)
+        summary = train_run(None, resume, resume=True, progress=not quiet, engine=engine, address=address,
+                            workers=workers)
     else:
         extra: tuple[str, ...] = (f"train.seed={seed}",) if seed is not None else ()
         if init is not None:  # absolute: the run's config.toml must find it from anywhere
             extra += (f"train.init={json.dumps(str(init.resolve()))}",)
         cfg = load_experiment(config, overrides + extra)
-        summary = train_run(cfg, out, progress=not quiet, engine=engine)
+        summary = train_run(cfg, out, progress=not quiet, engine=engine, address=address, workers=workers)
     print_summary(summary)
 
 

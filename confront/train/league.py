@@ -208,16 +208,18 @@ class SnapshotPolicy:
 
 
 
-def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, progress: bool = False
+def build_pool(cfg: ExperimentConfig, seed: int, battles: int | None = None, progress: bool = False,
+               part: dict[str, int] | None = None, td: OpponentPolicy | None = None
                ) -> tuple[PoolEnv, SnapshotPolicy]:
-    """The league as a PoolEnv; the self-play snapshot policy its ``self`` entries share."""
+    """The league as a PoolEnv; the self-play snapshot policy its ``self`` entries share. ``part``: only these
+    entries, with these battles (a Ray rollout worker's share, ``ppo_ray``; default every entry, ``battles`` or
+    its ``league.battles_of``); ``td``: the TD team's policy (default :func:`td_policy`, from its cache)."""
     space = tank_space(cfg)
     snap = SnapshotPolicy(space.dims)
-    td = None
     entries = []
-    for e in cfg.league.opponents:
+    for e in cfg.league.opponents if part is None else [e for e in cfg.league.opponents if e in part]:
         scen, _, opp = e.partition(":")
-        n = battles or cfg.league.battles_of(e)
+        n = part[e] if part is not None else battles or cfg.league.battles_of(e)
         if opp == "td":
             if td is None:
                 td = td_policy(cfg, progress)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from confront import checkpoint as ck
-from confront.arena.pool import PoolStep
+from confront.arena.pool import PoolEnv, PoolStep
 from confront.arena.tank import FEATURE_NAMES
 from confront.learning.ppo import PPO, UPDATE_STATS, Rollout
 from confront.runs import Run
@@ -30,7 +30,7 @@ from confront.train.loop import share_by_opponent
 from confront.train.ppo_model import save_tank_model, tank_space
 from confront.train.spec import ExperimentConfig
 
-__all__ = ["TankTrainer"]
+__all__ = ["TankTrainer", "collect_rollout", "critic_input"]
 
 
 class TankTrainer:
@@ -72,10 +72,6 @@ class TankTrainer:
 
     def _pick_snapshot(self) -> None:
         self.snap.load(self.snapshots[int(self.pool.rng.integers(len(self.snapshots)))])
-
-    def _critic(self, obs: np.ndarray) -> np.ndarray:
-        alive = obs[:, FEATURE_NAMES.index("energy")] > 0  # a dead tank has no energy
-        return self.ppo.critic_input(obs, self.pool.group, self.pool.n_groups, alive)
 
     def advance(self, limit: int, tick: Any = None) -> dict[str, Any]:
         """One rollout and update (:meth:`update`); rounds past ``limit`` are kept (every battle ends its round)."""
@@ -122,32 +118,17 @@ class TankTrainer:
 
     def _collect(self) -> tuple[Rollout, float]:
         """S steps of every battle with the acting policy: the rollout, and the seconds spent in the env."""
-        c, pool = self.ppo.config, self.pool
-        s, n = c.rollout_steps, pool.n_agents
-        crit = self._critic(self.obs)
-        buf = Rollout(obs=np.zeros((s, n, self.obs.shape[1]), np.float32),
-                      critic=np.zeros((s, n, crit.shape[1]), np.float32),
-                      heads=np.zeros((s, n, len(self.ppo.dims)), np.int64), logp=np.zeros((s, n), np.float32),
-                      value=np.zeros((s, n), np.float32), reward=np.zeros((s, n)), done=np.zeros((s, n), bool),
-                      active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
-        t_env = 0.0
-        playing = self._playing()
-        for k in range(s):
-            joint, heads, logp = self.ppo.act(self.obs)
-            te = time.perf_counter()
-            st: PoolStep = pool.step(joint, playing)
-            t_env += time.perf_counter() - te
-            buf.obs[k], buf.critic[k], buf.heads[k], buf.logp[k] = self.obs, crit, heads, logp
-            buf.reward[k], buf.done[k], buf.active[k] = st.reward * c.reward_scale, st.done, st.active
-            self.decisions += int(st.active.sum())
-            for r in st.rounds:
-                self.rows.append({"round": len(self.rows) + 1, **r, "decisions": self.decisions})
-            self.obs = st.obs
-            crit = self._critic(self.obs)
-        # the values of the whole rollout in one product (the weights acted with; cheaper than one per step)
-        buf.value[...] = self.ppo.values(buf.critic.reshape(s * n, -1), threads=c.threads).reshape(s, n)
-        buf.last_value = self.ppo.values(crit)
+        buf, self.obs, active, ended, t_env = collect_rollout(self.ppo, self.pool, self.obs, self._playing())
+        self._record(active, ended)
         return buf, t_env
+
+    def _record(self, active: np.ndarray, ended: list[list[dict[str, Any]]]) -> None:
+        """Count a rollout's decisions (``active`` (S,): the agents active at each step) and add the rounds that
+        ended at each step (``ended``), each row with the decisions made by the end of its step."""
+        for k, rounds in enumerate(ended):
+            self.decisions += int(active[k])
+            for r in rounds:
+                self.rows.append({"round": len(self.rows) + 1, **r, "decisions": self.decisions})
 
     def finish(self, run: Run, rows: list[dict[str, Any]], sessions: list[dict[str, Any]]) -> dict[str, Any]:
         """The model, ``metrics/updates.csv``, the figures; the summary's PPO keys."""
@@ -178,46 +159,97 @@ class TankTrainer:
 
     # checkpoint state
     def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        arrays = {f"pool.{k}": v for k, v in self.pool.state_dict().items()}
-        arrays.update({f"ppo.{k}": v for k, v in self.ppo.state_dict().items()})
+        arrays, meta = self._learner_state()
+        arrays.update({f"pool.{k}": v for k, v in self.pool.state_dict().items()})
+        arrays["obs"] = self.obs
+        meta["pool_rng"] = ck.rng_state(self.pool.rng)
+        return arrays, meta
+
+    def _learner_state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """What the learner holds: PPO, snapshots, the pending rollout, rows and counters."""
+        arrays = {f"ppo.{k}": v for k, v in self.ppo.state_dict().items()}
         for i, snap in enumerate(self.snapshots):
             arrays.update({f"snap{i}.{k}": v for k, v in snap.items()})
-        arrays["obs"] = self.obs
         if self.pending is not None:
             arrays.update({f"pending.{k}": v for k, v in asdict(self.pending).items()})
         meta = {"kind": "ppo", "rounds_done": self.rounds_done, "decisions": self.decisions, "rows": self.rows,
-                "updates": self.updates, "update_elapsed_s": self.elapsed, "snapshots": len(self.snapshots),
-                "pool_rng": ck.rng_state(self.pool.rng)}
+                "updates": self.updates, "update_elapsed_s": self.elapsed, "snapshots": len(self.snapshots)}
         return arrays, meta
 
     def load(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None:
-        def sub(prefix: str) -> dict[str, np.ndarray]:
-            return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}
-
+        if meta.get("rollout_workers"):
+            raise ck.CheckpointError(f"this run was trained on Ray with {meta['rollout_workers']} rollout workers: "
+                                     "resume it with --address (confront train --resume RUN --address ...)")
         try:
-            if meta.get("kind") != "ppo":
-                raise ValueError("not a PPO checkpoint")
-            self.pool.load_state_dict(sub("pool."))
-            self.ppo.load_state_dict(sub("ppo."))
-            n_snaps = int(meta["snapshots"])
-            held = {k.split(".", 1)[0] for k in arrays if k.startswith("snap")}
-            # the count first: the set of 10**8 names alone would take GBs (the snapshots' loop, hours)
-            if n_snaps != len(held) or held != {f"snap{i}" for i in range(n_snaps)}:
-                raise ValueError(f"snapshots = {n_snaps} but it holds {len(held)} snapshot(s)")
-            self.snapshots = [sub(f"snap{i}.") for i in range(n_snaps)]
-            actor = {k: (v.shape, v.dtype.kind) for k, v in self.ppo.actor_arrays().items()}
-            for i, snap in enumerate(self.snapshots):
-                if {k: (v.shape, v.dtype.kind) for k, v in snap.items()} != actor:
-                    raise ValueError(f"snapshot {i} does not fit the actor")
+            self._load_learner(arrays, meta)
+            self.pool.load_state_dict(_sub(arrays, "pool."))
             self.obs = np.asarray(arrays["obs"], dtype=np.float32)
-            pending = sub("pending.")
-            self.pending = Rollout(**pending) if pending else None
-            self.rows, self.updates = list(meta["rows"]), list(meta["updates"])
-            self.decisions = int(meta["decisions"])
-            self.elapsed = float(meta.get("update_elapsed_s", meta.get("elapsed_s", 0.0)))
             self.pool.rng = ck.rng_from_state(meta["pool_rng"])
         except (KeyError, ValueError, TypeError) as exc:
             raise ck.CheckpointError(f"checkpoint does not fit this run's config: {exc}") from None
+
+    def _load_learner(self, arrays: dict[str, np.ndarray], meta: dict[str, Any]) -> None:
+        """Restore :meth:`_learner_state` (KeyError, ValueError or TypeError on a checkpoint that does not fit)."""
+        if meta.get("kind") != "ppo":
+            raise ValueError("not a PPO checkpoint")
+        self.ppo.load_state_dict(_sub(arrays, "ppo."))
+        n_snaps = int(meta["snapshots"])
+        held = {k.split(".", 1)[0] for k in arrays if k.startswith("snap")}
+        # the count first: the set of 10**8 names alone would take GBs (the snapshots' loop, hours)
+        if n_snaps != len(held) or held != {f"snap{i}" for i in range(n_snaps)}:
+            raise ValueError(f"snapshots = {n_snaps} but it holds {len(held)} snapshot(s)")
+        self.snapshots = [_sub(arrays, f"snap{i}.") for i in range(n_snaps)]
+        actor = {k: (v.shape, v.dtype.kind) for k, v in self.ppo.actor_arrays().items()}
+        for i, snap in enumerate(self.snapshots):
+            if {k: (v.shape, v.dtype.kind) for k, v in snap.items()} != actor:
+                raise ValueError(f"snapshot {i} does not fit the actor")
+        pending = _sub(arrays, "pending.")
+        self.pending = Rollout(**pending) if pending else None
+        self.rows, self.updates = list(meta["rows"]), list(meta["updates"])
+        self.decisions = int(meta["decisions"])
+        self.elapsed = float(meta.get("update_elapsed_s", meta.get("elapsed_s", 0.0)))
+
+
+def _sub(arrays: dict[str, np.ndarray], prefix: str) -> dict[str, np.ndarray]:
+    """The arrays whose names start with ``prefix``, without it."""
+    return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}
+
+
+def critic_input(ppo: PPO, pool: PoolEnv, obs: np.ndarray) -> np.ndarray:
+    """The critic's inputs (N, C) of the pool's agents at ``obs`` (N, F)."""
+    alive = obs[:, FEATURE_NAMES.index("energy")] > 0  # a dead tank has no energy
+    return ppo.critic_input(obs, pool.group, pool.n_groups, alive)
+
+
+def collect_rollout(ppo: PPO, pool: PoolEnv, obs: np.ndarray, playing: np.ndarray | None
+                    ) -> tuple[Rollout, np.ndarray, np.ndarray, list[list[dict[str, Any]]], float]:
+    """``ppo.config.rollout_steps`` steps of the pool's battles (the ``playing`` entries', or all) from ``obs``,
+    acting with ``ppo``: (the rollout, the observations after it, the agents active at each step (S,), the rounds
+    that ended at each step, the seconds spent in the env)."""
+    c = ppo.config
+    s, n = c.rollout_steps, pool.n_agents
+    crit = critic_input(ppo, pool, obs)
+    buf = Rollout(obs=np.zeros((s, n, obs.shape[1]), np.float32),
+                  critic=np.zeros((s, n, crit.shape[1]), np.float32),
+                  heads=np.zeros((s, n, len(ppo.dims)), np.int64), logp=np.zeros((s, n), np.float32),
+                  value=np.zeros((s, n), np.float32), reward=np.zeros((s, n)), done=np.zeros((s, n), bool),
+                  active=np.zeros((s, n), bool), last_value=np.zeros(n, np.float32))
+    t_env = 0.0
+    ended: list[list[dict[str, Any]]] = []
+    for k in range(s):
+        joint, heads, logp = ppo.act(obs)
+        te = time.perf_counter()
+        st: PoolStep = pool.step(joint, playing)
+        t_env += time.perf_counter() - te
+        buf.obs[k], buf.critic[k], buf.heads[k], buf.logp[k] = obs, crit, heads, logp
+        buf.reward[k], buf.done[k], buf.active[k] = st.reward * c.reward_scale, st.done, st.active
+        ended.append(list(st.rounds))
+        obs = st.obs
+        crit = critic_input(ppo, pool, obs)
+    # the values of the whole rollout in one product (the weights acted with; cheaper than one per step)
+    buf.value[...] = ppo.values(buf.critic.reshape(s * n, -1), threads=c.threads).reshape(s, n)
+    buf.last_value = ppo.values(crit)
+    return buf, obs, buf.active.sum(axis=1), ended, t_env
 
 
 def record_tank_round(cfg: ExperimentConfig, ppo: PPO, out_dir: Path, entry: str | None = None) -> str:

@@ -1,45 +1,96 @@
 """End-to-end training throughput of the recommended learner (PPO tanks against the league): agent-decisions
 per second with the env, inference and updates all counted, and where the time goes. Prints a table, then
-one JSON line. No assertions (figures go to docs/learning.md)."""
+one JSON line. No assertions (figures go to docs/learning.md).
+
+``--workers 0,1,2 [--address ray://HOST:PORT|auto]``: the scale-out rows instead, the config's league with 0
+(the local path), 1 and 2 Ray rollout workers (``confront.train.ppo_ray``; without --address a local Ray of this
+machine's CPUs), each with its peak resident memory: the driver's (``getrusage``, its children's included) and
+each worker's own, summed."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import resource
 import time
+from typing import Any
 
 from confront.train.ppo_sim import TankTrainer
 from confront.train.spec import load_experiment
 
 
 def measure(opponents: list[str] | None, battles: int, updates: int, config: str = "tanks", overlap: bool = True,
-            threads: int = 2, precision: str | None = None) -> dict[str, float | int | str]:
+            threads: int = 2, precision: str | None = None, workers: int = 0,
+            address: str | None = None) -> dict[str, float | int | str]:
     """Run ``updates`` PPO updates after two warm-up ones (kernels compile; the first has no update before it);
-    figures over the timed ones. ``opponents`` None: the config's own league (battles, focus) as it trains."""
+    figures over the timed ones. ``opponents`` None: the config's own league (battles, focus) as it trains.
+    ``workers`` > 0: the rollouts on that many Ray actors (``address``: the cluster, Ray already up if None)."""
     ov = [f"ppo.overlap={str(overlap).lower()}", f"ppo.threads={threads}"]
     if precision is not None:
         ov.append(f"ppo.precision={precision}")
     if opponents is not None:
         ov += [f"league.opponents={json.dumps(opponents)}", f"league.battles={battles}", "league.focus=[]"]
     cfg = load_experiment(config, ov)
-    trainer = TankTrainer(cfg)
-    trainer.update()  # warm-up: numba kernels, torch
-    trainer.update()
-    d0, t0, c0 = trainer.decisions, time.perf_counter(), time.process_time()
-    env = upd = 0.0
-    for _ in range(updates):
-        row = trainer.update()
-        env += row["env_fraction"]
-        upd += row["update_wait_fraction"]
-    wall = time.perf_counter() - t0
-    n = trainer.decisions - d0
+    trainer: Any
+    if workers:
+        from confront.train.ppo_ray import RayTankTrainer
+
+        trainer = RayTankTrainer(cfg, address or "auto", workers)
+        agents = trainer.n_agents
+    else:
+        trainer = TankTrainer(cfg)
+        agents = trainer.pool.n_agents
+    try:
+        trainer.update()  # warm-up: numba kernels, torch
+        trainer.update()
+        d0, t0, c0 = trainer.decisions, time.perf_counter(), time.process_time()
+        env = upd = 0.0
+        for _ in range(updates):
+            row = trainer.update()
+            env += row["env_fraction"]
+            upd += row["update_wait_fraction"]
+        wall = time.perf_counter() - t0
+        n = trainer.decisions - d0
+        worker_rss = 0
+        if workers:
+            import ray
+
+            worker_rss = sum(ray.get([w.peak_rss_bytes.remote() for w in trainer.workers]))
+    finally:
+        trainer.close()
     league = ",".join(opponents) if opponents is not None else f"its own ({len(cfg.league.opponents)} entries)"
     return {"config": config, "overlap": overlap, "threads": threads, "precision": cfg.ppo.precision, "league": league,
-            "agents": trainer.pool.n_agents,
+            "agents": agents, "workers": workers,
             "decisions": n,
             "decisions_per_s": n / wall, "decisions_per_cpu_s": n / (time.process_time() - c0),
-            "env_fraction": env / updates, "update_wait_fraction": upd / updates, "wall_s": wall}
+            "env_fraction": env / updates, "update_wait_fraction": upd / updates, "wall_s": wall,
+            "driver_peak_rss_mib": _peak_rss() / 2**20, "workers_peak_rss_mib": worker_rss / 2**20}
+
+
+def _peak_rss() -> int:
+    """Peak resident bytes of this process and of its children that ended (Linux: ru_maxrss in KiB)."""
+    return sum(resource.getrusage(who).ru_maxrss for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)) * 1024
+
+
+def scale_out(args: argparse.Namespace) -> None:
+    """The rows of --workers: one config, 0 / 1 / 2 ... rollout workers."""
+    counts = [int(w) for w in args.workers.split(",")]
+    if any(counts) and args.address is None:
+        import ray
+
+        ray.init(num_cpus=os.cpu_count(), include_dashboard=False, log_to_driver=False)
+    rows = [measure(None, 0, args.updates, args.config, overlap=args.overlap, threads=args.threads,
+                    precision=args.precision, workers=w, address=args.address) for w in counts]
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    print("| config | rollout workers | agents | decisions/s | env (slowest worker) | update (or waiting for it) | "
+          "peak RSS driver | peak RSS workers |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    for r in rows:
+        print(f"| {r['config']} | {r['workers'] or 'local'} | {r['agents']} | {r['decisions_per_s']:,.0f} | "
+              f"{r['env_fraction']:.0%} | {r['update_wait_fraction']:.0%} | {r['driver_peak_rss_mib']:,.0f} MiB | "
+              f"{r['workers_peak_rss_mib']:,.0f} MiB |")
+    print(json.dumps({"bench": "train-scale-out", "load": os.getloadavg()[0], "rows": rows}))
 
 
 def main() -> None:
@@ -49,7 +100,15 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=2, help="ppo.threads (the update's torch threads)")
     ap.add_argument("--precision", choices=("fp32", "bf16"), help="ppo.precision (default: each config's own)")
     ap.add_argument("--no-overlap", action="store_true", help="only the sequential schedule (the default one)")
+    ap.add_argument("--workers", metavar="N,N,...", help="scale-out rows instead: these rollout worker counts "
+                    "(0: the local path), e.g. 0,1,2")
+    ap.add_argument("--address", help="with --workers: the Ray cluster (ray://HOST:PORT or auto; default a local Ray)")
+    ap.add_argument("--config", default="tanks", help="with --workers: the config whose league trains")
+    ap.add_argument("--overlap", action="store_true", help="with --workers: ppo.overlap (workers act one update "
+                    "behind while the driver updates)")
     args = ap.parse_args()
+    if args.workers is not None:
+        return scale_out(args)
     league = ["1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Crazy"]
     teams = ["4v4:SpinBot", "4v4:Walls", "4v4:dodge", "4v4:self"]
     rows = []

@@ -137,7 +137,8 @@ def demo(out: Path | None, rounds: int | None, seed: int | None, paper: bool, co
 @set_option
 def train(config: str, out: Path | None, resume: Path | None, seed: int | None, engine: str, init: Path | None,
           address: str | None, workers: int | None, quiet: bool, overrides: tuple[str, ...]) -> None:
-    """Train one arm of an experiment; --resume RUN continues a killed run from its latest checkpoint."""
+    """Train one arm of an experiment; --resume RUN continues a killed run from its latest checkpoint; --address
+    collects PPO's rollouts on Ray actors."""
     from confront.train.factory import train_run
     from confront.train.loop import print_summary
     from confront.train.spec import load_experiment

@@ -112,6 +112,8 @@ def _resume_workers(run: Run, address: str | None, workers: int | None) -> int |
         held = json.loads((latest / "meta.json").read_text(encoding="utf-8")).get("rollout_workers", 0)
     except (OSError, ValueError, AttributeError):
         return workers  # run_trainer's check of the checkpoint names what is wrong
+    if isinstance(held, bool) or not isinstance(held, int) or not 0 <= held <= 4096:
+        raise ck.CheckpointError(f"{latest} has rollout_workers = {str(held)[:40]}: not a worker count")
     if held and address is None:
         raise ck.CheckpointError(f"{run.path} was trained on Ray with {held} rollout workers: resume it with "
                                  f"--address HOST:PORT|auto")

@@ -136,6 +136,12 @@ class RolloutWorker:
         buf, self.obs, active, ended, t_env = collect_rollout(self.ppo, self.pool, self.obs, playing)
         return {"rollout": asdict(buf), "active": active, "ended": ended, "env_s": t_env}
 
+    def peak_rss_bytes(self) -> int:
+        """This process's peak resident memory (Linux: ru_maxrss in KiB)."""
+        import resource
+
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
     def state(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         """Its pool, observations and acting stream (arrays), its pool generator (meta)."""
         arrays = {f"pool.{k}": v for k, v in self.pool.state_dict().items()}

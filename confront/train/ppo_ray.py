@@ -25,7 +25,8 @@
   worker count is the checkpoint's); resuming a Ray run without ``--address``, or a local run with it, is refused.
 
 Every update sends the weights (and the snapshots) to every worker and gathers S x N observations, critic
-inputs and heads: about ``4 S N (3 F + H + 6)`` bytes a rollout. One learner: the update does not scale with W.
+inputs and heads: about ``S N (12 F + 8 H + 18)`` bytes a rollout with the team critic (the whole league: 25 MB).
+One learner: the update does not scale with W (docs/learning.md, "Scale-out on Ray").
 """
 
 from __future__ import annotations

@@ -47,6 +47,7 @@ from confront.config import ConfigError
 from confront.learning.ppo import PPO, Rollout
 from confront.runs import Run
 from confront.train.league import build_pool, pfsp_playing, recent_shares, td_policy
+from confront.train.ppo_model import tank_space
 from confront.train.ppo_sim import TankTrainer, _sub, collect_rollout
 from confront.train.spec import ExperimentConfig
 
@@ -115,7 +116,7 @@ class RolloutWorker:
     def __init__(self, cfg: ExperimentConfig, part: dict[str, int], seed: int, td: OpponentPolicy | None) -> None:
         self.cfg = cfg
         self.pool, self.snap = build_pool(cfg, seed, part=part, td=td)
-        self.ppo = PPO(self.pool.n_features, self.pool.action_dims, cfg.ppo, seed=seed)
+        self.ppo = PPO(self.pool.n_features, self.pool.action_dims, cfg.ppo, seed=seed)  # acts on the driver's weights
         self.obs = self.pool.reset()
         names = list(cfg.league.opponents)
         self.mine = np.array([names.index(e.name) for e in self.pool.entries])
@@ -182,7 +183,8 @@ class RayTankTrainer(TankTrainer):
             raise
         n_features, dims = shapes[0][0], shapes[0][1]
         self.n_agents = sum(s[2] for s in shapes)  # the pools' agents, all workers
-        self.ppo = PPO(n_features, dims, cfg.ppo, seed=cfg.train.seed)
+        self.ppo = PPO(n_features, dims, cfg.ppo, seed=cfg.train.seed,
+                       init_logits=tank_space(cfg).skill_logits(cfg.tank.skill_prior))
         self.names = list(cfg.league.opponents)
         self.snapshots: list[dict[str, np.ndarray]] = []
         self.rows: list[dict[str, Any]] = []

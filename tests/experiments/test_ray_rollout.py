@@ -79,9 +79,15 @@ def test_the_league_splits_over_workers_by_battles() -> None:
     assert all(0 <= worker_seed(2**32 - 1, w) < 2**32 for w in range(4))
 
 
-@pytest.mark.parametrize(("overlap", "prioritise"), [("false", "false"), ("true", "true")])
-def test_one_worker_is_the_local_path_bit_for_bit(tmp_path: Path, overlap: str, prioritise: str) -> None:
-    cfg = _cfg(**{"train.rounds": "14", "ppo.overlap": overlap, "league.prioritise": prioritise})
+SKILLS = {"tank.leads": '["none","linear","circular","gf"]', "tank.surf": "true", "tank.knowledge": "true",
+          "tank.skill_prior": "3.0"}  # the tanks-tech tank: its prior is in the learner's first weights
+
+
+@pytest.mark.parametrize(("overlap", "prioritise", "skills"), [("false", "false", False), ("true", "true", False),
+                                                                ("false", "true", True)])
+def test_one_worker_is_the_local_path_bit_for_bit(tmp_path: Path, overlap: str, prioritise: str, skills: bool) -> None:
+    cfg = _cfg(**{"train.rounds": "14", "ppo.overlap": overlap, "league.prioritise": prioritise,
+                  **(SKILLS if skills else {})})
     local = train_run(cfg, tmp_path / "local", progress=False)
     on_ray = train_run(cfg, tmp_path / "ray", progress=False, address="auto", workers=1)
     assert on_ray["rollout_workers"] == 1 and on_ray["rollout_worker_restarts"] == 0

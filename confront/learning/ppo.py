@@ -227,8 +227,10 @@ class PPO:
         if init_logits is not None:  # a prior over the choices: added to the output layer's (zero) biases
             if np.shape(init_logits) != (sum(dims),) or not np.all(np.isfinite(init_logits)):
                 raise ValueError(f"init_logits must be {sum(dims)} finite numbers, got shape {np.shape(init_logits)}")
+            out = self.net.actor[-1]
+            assert isinstance(out, nn.Linear)
             with torch.no_grad():
-                self.net.actor[-1].bias.add_(torch.from_numpy(np.asarray(init_logits, dtype=np.float32)))
+                out.bias.add_(torch.from_numpy(np.asarray(init_logits, dtype=np.float32)))
         self.opt = torch.optim.Adam(self.net.parameters(), lr=self.config.lr, eps=1e-5)
         self.gen = torch.Generator().manual_seed(seed)  # minibatch order
         self.act_gen = torch.Generator().manual_seed(seed + 1)  # action sampling (its own stream: acting and

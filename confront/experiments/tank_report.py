@@ -45,6 +45,7 @@ if TYPE_CHECKING:
 
 # the issue's targets per kind of entry: (share, what)
 TARGETS = {"1v1": 0.90, "4v4": 0.80, "4v4:td": 0.75, "4v4:dodge": 0.65}
+TECH_TARGETS = {"1v1": 0.60, "4v4": 0.70}  # against the technique robots (issue 32)
 # robots of the Robocode distribution the policy never met in training (the engine's own, no simulator twin
 # needed): does it win by what it learned about tanks rather than about its eight opponents?
 UNSEEN = ("1v1:MyFirstRobot", "1v1:sample.MyFirstJuniorRobot", "1v1:sample.PaintingRobot", "1v1:Target",
@@ -58,7 +59,9 @@ def target_of(entry: str) -> float | None:
         return TARGETS[entry]
     if opp in ("self", "strafe", "random", "dodge", "td"):
         return None
-    return TARGETS.get(scen)
+    from confront.arena.tech import TECH_ROBOTS
+
+    return (TECH_TARGETS if opp in TECH_ROBOTS else TARGETS).get(scen)
 
 
 def mean_interval(values: list[float]) -> tuple[float, float, float]:

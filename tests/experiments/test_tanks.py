@@ -146,6 +146,7 @@ def test_report_targets_and_intervals() -> None:
     from confront.experiments.tank_report import mean_interval, target_of
 
     assert target_of("1v1:Walls") == 0.90 and target_of("4v4:Crazy") == 0.80
+    assert target_of("1v1:SurfGF") == 0.60 and target_of("4v4:RiskGF") == 0.70  # the technique robots
     assert target_of("4v4:td") == 0.75 and target_of("4v4:dodge") == 0.65 and target_of("1v1:self") is None
     m, lo, hi = mean_interval([0.8, 0.9, 1.0])
     assert m == pytest.approx(0.9) and lo == pytest.approx(0.9 - 4.302653 * 0.1 / math.sqrt(3), rel=1e-5)

@@ -14,6 +14,7 @@ import json
 import os
 import resource
 import time
+from collections.abc import Callable
 from typing import Any
 
 from confront.train.ppo_sim import TankTrainer
@@ -82,15 +83,25 @@ def scale_out(args: argparse.Namespace) -> None:
         ray.init(num_cpus=os.cpu_count(), include_dashboard=False, log_to_driver=False)
     rows = [measure(None, 0, args.updates, args.config, overlap=args.overlap, threads=args.threads,
                     precision=args.precision, workers=w, address=args.address) for w in counts]
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print("| config | rollout workers | agents | decisions/s | env (slowest worker) | update (or waiting for it) | "
-          "peak RSS driver | peak RSS workers |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
-    for r in rows:
-        print(f"| {r['config']} | {r['workers'] or 'local'} | {r['agents']} | {r['decisions_per_s']:,.0f} | "
-              f"{r['env_fraction']:.0%} | {r['update_wait_fraction']:.0%} | {r['driver_peak_rss_mib']:,.0f} MiB | "
-              f"{r['workers_peak_rss_mib']:,.0f} MiB |")
+    print_table(rows, 1, {
+        "config": lambda r: r["config"], "rollout workers": lambda r: r["workers"] or "local",
+        "agents": lambda r: r["agents"], "decisions/s": lambda r: f"{r['decisions_per_s']:,.0f}",
+        "env (slowest worker)": lambda r: f"{r['env_fraction']:.0%}",
+        "update (or waiting for it)": lambda r: f"{r['update_wait_fraction']:.0%}",
+        "peak RSS driver": lambda r: f"{r['driver_peak_rss_mib']:,.0f} MiB",
+        "peak RSS workers": lambda r: f"{r['workers_peak_rss_mib']:,.0f} MiB"})
     print(json.dumps({"bench": "train-scale-out", "load": os.getloadavg()[0], "rows": rows}))
+
+
+def print_table(rows: list[dict[str, Any]], text_columns: int, columns: dict[str, Callable[[dict[str, Any]], Any]]
+                ) -> None:
+    """The load average, then a Markdown table: one column per ``columns`` entry (its header, the cell of a row),
+    the first ``text_columns`` left-aligned."""
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+    print("| " + " | ".join(columns) + " |")
+    print("|" + "---|" * text_columns + "---:|" * (len(columns) - text_columns))
+    for r in rows:
+        print("| " + " | ".join(str(cell(r)) for cell in columns.values()) + " |")
 
 
 def main() -> None:
@@ -119,14 +130,12 @@ def main() -> None:
                  measure(None, 0, args.updates, "tanks-demo", overlap=overlap, **kw),
                  measure(league, args.battles * 2, args.updates, overlap=overlap, **kw),
                  measure(teams, args.battles, args.updates, overlap=overlap, **kw)]
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print("| config | overlap | precision | league | agents | decisions/s | decisions/CPU-s | env | update (or waiting "
-          "for it) |")
-    print("|---|---|---|---|---:|---:|---:|---:|---:|")
-    for r in rows:
-        print(f"| {r['config']} | {r['overlap']} | {r['precision']} | {r['league']} | {r['agents']} | "
-              f"{r['decisions_per_s']:,.0f} | "
-              f"{r['decisions_per_cpu_s']:,.0f} | {r['env_fraction']:.0%} | {r['update_wait_fraction']:.0%} |")
+    print_table(rows, 4, {
+        "config": lambda r: r["config"], "overlap": lambda r: r["overlap"], "precision": lambda r: r["precision"],
+        "league": lambda r: r["league"], "agents": lambda r: r["agents"],
+        "decisions/s": lambda r: f"{r['decisions_per_s']:,.0f}",
+        "decisions/CPU-s": lambda r: f"{r['decisions_per_cpu_s']:,.0f}", "env": lambda r: f"{r['env_fraction']:.0%}",
+        "update (or waiting for it)": lambda r: f"{r['update_wait_fraction']:.0%}"})
     print(json.dumps({"bench": "train", "load": os.getloadavg()[0], "rows": rows}))
 
 

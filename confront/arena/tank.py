@@ -167,16 +167,6 @@ class TankSpace:
         return (len(self.distances) + int(self.surf), len(self.turns_deg), len(self.fire_powers), self.enemy_slots,
                 len(self.leads))
 
-    def skill_logits(self, prior: float) -> np.ndarray:
-        """(sum(dims),) initial logit bonus of the skills' choices: ``prior`` on surf (the distance head's last
-        entry) and on the gf lead, 0 elsewhere (all 0 without those skills)."""
-        out = np.zeros(sum(self.dims))
-        if self.surf:
-            out[len(self.distances)] = prior
-        if "gf" in self.leads:
-            out[sum(self.dims[:4]) + self.leads.index("gf")] = prior
-        return out
-
     @property
     def n_actions(self) -> int:
         """Joint actions."""

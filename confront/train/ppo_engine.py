@@ -58,7 +58,7 @@ from confront.runs import Run
 from confront.train.engine_logs import Decision, ScoreLog, read_decisions, read_scores, round_rows
 from confront.train.league import PAPER_MOVE_OPPONENTS, paper_move_robot
 from confront.train.loop import share_by_opponent
-from confront.train.ppo_model import load_tank_model, save_tank_model, tank_space
+from confront.train.ppo_model import load_tank_model, save_tank_model, skill_logits, tank_space
 from confront.train.spec import SCRIPTED_BOTS, TECH_BOTS, ExperimentConfig
 
 __all__ = ["EngineTankTrainer", "episode_rewards", "pack_episodes", "engine_entries"]
@@ -142,7 +142,7 @@ class EngineTankTrainer:
         self.cpu_constant_ms = TANK_CPU_CONSTANT_MS if cpu_constant_ms is None else cpu_constant_ms
         self.space = tank_space(cfg)
         self.ppo = PPO(self.space.n_features, self.space.dims, cfg.ppo, seed=cfg.train.seed,
-                       init_logits=self.space.skill_logits(cfg.tank.skill_prior))
+                       init_logits=skill_logits(self.space, cfg.tank.skill_prior))
         self.info: dict[str, Any] = {}
         if cfg.train.init:
             self.ppo.load_state_dict(load_tank_model(cfg.train.init, cfg).state_dict())

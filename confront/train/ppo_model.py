@@ -21,7 +21,7 @@ from confront.arena.tank import TankSpace
 from confront.learning.ppo import PPO
 from confront.train.spec import ExperimentConfig
 
-__all__ = ["tank_space", "smdp_tank_config", "save_tank_model", "load_tank_model"]
+__all__ = ["tank_space", "skill_logits", "smdp_tank_config", "save_tank_model", "load_tank_model"]
 
 
 def tank_space(cfg: ExperimentConfig) -> TankSpace:
@@ -30,6 +30,17 @@ def tank_space(cfg: ExperimentConfig) -> TankSpace:
     return TankSpace(distances=tuple(t.distances), turns_deg=tuple(t.turns_deg), turn_mode=t.turn_mode,
                      fire_powers=tuple(t.fire_powers), enemy_slots=t.enemy_slots, mate_slots=t.mate_slots,
                      leads=tuple(t.leads), surf=t.surf, knowledge=t.knowledge)
+
+
+def skill_logits(space: TankSpace, prior: float) -> np.ndarray:
+    """(sum(dims),) initial logit bonus of the skills' choices (``tank.skill_prior``): ``prior`` on surf (the
+    distance head's last entry) and on the gf lead, 0 elsewhere (all 0 without those skills)."""
+    out = np.zeros(sum(space.dims))
+    if space.surf:
+        out[len(space.distances)] = prior
+    if "gf" in space.leads:
+        out[sum(space.dims[:4]) + space.leads.index("gf")] = prior
+    return out
 
 
 def smdp_tank_config(cfg: ExperimentConfig) -> SMDPConfig:

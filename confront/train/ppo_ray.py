@@ -47,7 +47,7 @@ from confront.config import ConfigError
 from confront.learning.ppo import PPO, Rollout
 from confront.runs import Run
 from confront.train.league import build_pool, pfsp_playing, recent_shares, td_policy
-from confront.train.ppo_model import tank_space
+from confront.train.ppo_model import skill_logits, tank_space
 from confront.train.ppo_sim import TankTrainer, _sub, collect_rollout
 from confront.train.spec import ExperimentConfig
 
@@ -184,7 +184,7 @@ class RayTankTrainer(TankTrainer):
         n_features, dims = shapes[0][0], shapes[0][1]
         self.n_agents = sum(s[2] for s in shapes)  # the pools' agents, all workers
         self.ppo = PPO(n_features, dims, cfg.ppo, seed=cfg.train.seed,
-                       init_logits=tank_space(cfg).skill_logits(cfg.tank.skill_prior))
+                       init_logits=skill_logits(tank_space(cfg), cfg.tank.skill_prior))
         self.names = list(cfg.league.opponents)
         self.snapshots: list[dict[str, np.ndarray]] = []
         self.rows: list[dict[str, Any]] = []

@@ -27,7 +27,7 @@ from confront.learning.ppo import PPO, UPDATE_STATS, Rollout
 from confront.runs import Run
 from confront.train.league import build_pool, pfsp_playing, recent_shares
 from confront.train.loop import share_by_opponent
-from confront.train.ppo_model import save_tank_model, tank_space
+from confront.train.ppo_model import save_tank_model, skill_logits, tank_space
 from confront.train.spec import ExperimentConfig
 
 __all__ = ["TankTrainer", "collect_rollout", "critic_input"]
@@ -45,7 +45,7 @@ class TankTrainer:
         self.cfg = cfg
         self.pool, self.snap = build_pool(cfg, cfg.train.seed, progress=progress)
         self.ppo = PPO(self.pool.n_features, self.pool.action_dims, cfg.ppo, seed=cfg.train.seed,
-                       init_logits=tank_space(cfg).skill_logits(cfg.tank.skill_prior))
+                       init_logits=skill_logits(tank_space(cfg), cfg.tank.skill_prior))
         self.snapshots: list[dict[str, np.ndarray]] = []
         self.obs = self.pool.reset()
         self.rows: list[dict[str, Any]] = []

@@ -266,11 +266,12 @@ def test_thread_pools_spin_briefly_unless_the_user_says_otherwise(var: str, give
 
 def test_skill_prior_sets_the_untrained_policys_probabilities() -> None:
     from confront.arena.tank import TankSpace
+    from confront.train.ppo_model import skill_logits
 
     space = TankSpace(leads=("none", "linear", "circular", "gf"), surf=True)
-    logits = space.skill_logits(3.0)
+    logits = skill_logits(space, 3.0)
     assert logits.tolist() == [0] * 5 + [3] + [0] * 16 + [3]  # surf ends the distance head, gf the lead head
-    assert not TankSpace().skill_logits(3.0).any()  # no skill: no prior
+    assert not skill_logits(TankSpace(), 3.0).any()  # no skill: no prior
     obs = np.random.default_rng(0).normal(size=(4096, space.n_features)).astype(np.float32)
     ppo = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=logits)
     _, heads, _ = ppo.act(obs)
@@ -279,7 +280,7 @@ def test_skill_prior_sets_the_untrained_policys_probabilities() -> None:
     assert abs(surf - want[0]) < 0.03 and abs(gf - want[1]) < 0.03
     assert abs((heads[:, 2] == 0).mean() - 0.25) < 0.03  # the fire head untouched
     plain = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1)
-    same = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=space.skill_logits(0.0))
+    same = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=skill_logits(space, 0.0))
     for a, b in zip(plain.state_dict().values(), same.state_dict().values(), strict=True):
         np.testing.assert_array_equal(a, b)  # a zero prior changes no bit
     with pytest.raises(ValueError, match="init_logits"):

@@ -60,7 +60,7 @@ from .scenarios import SAMPLE_TEAMS, Scenario, get_scenario, opponent_members
 from .smdp_kernel import Brains, Outputs, Senses, Tanks, Views, prepare_actions, smdp_turns
 from .state import SCORE_PARTS
 from .tank import KNOWLEDGE_FEATURES, MEMORY_ROWS, TankSpace, action_table, tank_view_kernel
-from .tech import BRAIN, TECH_ROBOTS, TechBots, knowledge_kernel, no_tech_state
+from .tech import TECH_ROBOTS, TechBots, knowledge_kernel, no_tech_state
 
 Reward = Literal["eq35", "score"]  # Eq. 35 per turn, or the change of the team's score margin
 
@@ -582,7 +582,7 @@ def _brains(arena: Arena, tank: TankSpace | None, tank_actions: np.ndarray, team
     if tank is None or not tank.skills or not tank_actions.any():
         return None
     mates = [int(sum(1 << j for j in range(len(team)) if team[j] == team[i])) for i in range(len(team))]
-    return TechBots(arena, [BRAIN if on else None for on in tank_actions], rounds_per_battle, mates)
+    return TechBots(arena, [tank.brain if on else None for on in tank_actions], rounds_per_battle, mates)
 
 
 _PARALLEL_MIN_BATTLES = 8

@@ -95,6 +95,9 @@ MATE_FEATURES = 5
 MAX_AGE = 50.0  # turns: older scans read as 1
 WALL_MARGIN = 18.0  # half a robot: a tank's centre never gets closer to a wall (Robocode's 36 px body)
 LEADS = {"none": 0, "linear": 1, "circular": 2, "gf": 3}
+# the technique robots (confront.arena.tech) a tank's skills may run as its brain: wave surfers, with the GuessFactor
+# gun, or with it and the anti-surfer gun beside it (the one that hits more aims)
+BRAINS = ("SurfGF", "SurfAS")
 LEAD_GF = LEADS["gf"]
 KNOWLEDGE_FEATURES = 8  # the knowledge block (tech.knowledge_row)
 KNOWLEDGE_NAMES = ("vg_head", "vg_linear", "vg_circular", "vg_gf", "waves", "wave_impact", "gf_peak", "surf_peak")
@@ -134,6 +137,7 @@ class TankSpace:
     leads: tuple[str, ...] = ("none", "circular")  # the lead head's choices, of LEADS
     surf: bool = False  # the distance head's extra last entry: the body follows the brain's movement (skills)
     knowledge: bool = False  # the knowledge block at the end of the view (skills)
+    brain: str = "SurfGF"  # the technique robot of BRAINS whose decisions the skills follow
 
     def __post_init__(self) -> None:
         for name in ("distances", "turns_deg", "fire_powers"):
@@ -155,6 +159,8 @@ class TankSpace:
         for name in ("surf", "knowledge"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"tank.{name} must be true or false, got {getattr(self, name)!r}")
+        if self.brain not in BRAINS:
+            raise ValueError(f"tank.brain must be one of {', '.join(BRAINS)}, got {self.brain!r}")
 
     @property
     def skills(self) -> bool:

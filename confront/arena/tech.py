@@ -41,9 +41,9 @@ from .strictmath import strict_cos, strict_sin
 from .tank import KNOWLEDGE_FEATURES
 
 __all__ = ["TECH_ROBOTS", "TechBots", "TechState", "tech_kind", "tech_battle", "tech_battle_step", "poses_per_turn",
-           "knowledge_row", "guess_aim", "BRAIN"]
+           "knowledge_row", "guess_aim"]
 
-G_HEAD, G_LINEAR, G_CIRCULAR, G_GF, G_VIRTUAL = range(5)
+G_HEAD, G_LINEAR, G_CIRCULAR, G_GF, G_VIRTUAL, G_AS = range(6)
 MV_ORBIT, MV_STOPGO, MV_RAM, MV_SURF, MV_RISK = range(5)
 # name: (gun, movement), as the Java subclasses pick them (confront.engine.tech_robots lists the same names)
 TECH_ROBOTS: dict[str, tuple[int, int]] = {
@@ -56,9 +56,9 @@ TECH_ROBOTS: dict[str, tuple[int, int]] = {
     "SurfCircular": (G_CIRCULAR, MV_SURF),
     "SurfGF": (G_GF, MV_SURF),
     "SurfVG": (G_VIRTUAL, MV_SURF),
+    "SurfAS": (G_AS, MV_SURF),
     "RiskGF": (G_GF, MV_RISK),
 }
-BRAIN = "SurfGF"  # a learning tank's technique brain (confront.arena.tank's skills)
 
 BINS, MID = 31, 15
 SEGMENTS = 5 * 3 * 3 * 3
@@ -82,13 +82,17 @@ WX, WY, WT, WS, WA, WD, WON = range(7)
 W_SIZE = 7
 G0 = W0 + MAXW * W_SIZE
 GX, GY, GT, GS, GA, GD, GM, GSEG, GTGT, GON, GAIM = range(11)
-G_SIZE = GAIM + NGUNS
+G_SIZE = GAIM + NGUNS + 1  # the aims of the NGUNS guns, then the anti-surfer aim
 M_SIZE = G0 + MAXG * G_SIZE
 # per-battle memory (stat[b, i, :]): GuessFactor visit counts, surfing hit statistics, virtual-gun hit rates
 S_GF = 0
 S_SURF = S_GF + SEGMENTS * BINS
 S_VG = S_SURF + BINS
-S_SIZE = S_VG + NGUNS
+S_AS = S_VG + NGUNS  # anti-surfer visit counts: distance segment x bin, rolling (AS_DECAY per visit)
+S_ASR = S_AS + 5 * BINS  # the anti-surfer aim's rolling hit rate (beside S_VG's)
+S_SIZE = S_ASR + 1
+AS_DECAY = 0.7  # the anti-surfer counts fade by this at each visit of their segment
+AS_MARGIN = 0.03  # G_AS aims by the anti-surfer counts while their hit rate beats the GuessFactor aim's by this
 MAX_HITS = 8
 MAX_IMPACT = 50.0  # turns: the knowledge block's wave time to impact saturates there
 assert KNOWLEDGE_FEATURES == NGUNS + 4
@@ -412,6 +416,16 @@ def _segment(m, t, w, h):
 
 
 @njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
+def _peak(st, base):
+    """The fullest bin of the BINS counts at ``st[base:]`` (the first of equals; MID first)."""
+    best = MID
+    for k in range(BINS):
+        if st[base + k] > st[base + best]:
+            best = k
+    return best
+
+
+@njit(cache=True, forceinline=False, _nrt=False, error_model="numpy")
 def _aim_and_fire(m, st, cmd, gun_kind, move_kind, t, x, y, now, energy, gun_heading, gun_heat, gun_rem, w, h):
     e = E0 + t * E_SIZE
     power = min(3.0, 1.2 + 300.0 / m[e + ED])
@@ -445,20 +459,33 @@ def _aim_and_fire(m, st, cmd, gun_kind, move_kind, t, x, y, now, energy, gun_hea
                     st[base + c - 1] += 0.5
                 if c < BINS - 1:
                     st[base + c + 1] += 0.5
+                base = S_AS + int(m[q + GSEG]) // 27 * BINS
+                for j in range(BINS):
+                    st[base + j] *= AS_DECAY
+                st[base + c] += 1.0
+                if c > 0:
+                    st[base + c - 1] += 0.5
+                if c < BINS - 1:
+                    st[base + c + 1] += 0.5
                 width = java_atan2(18.0, d)
                 for gq in range(NGUNS):
                     hit = 1.0 if abs(normal_relative_angle(m[q + GAIM + gq] - actual)) < width else 0.0
                     st[S_VG + gq] = (st[S_VG + gq] * 19 + hit) / 20
+                hit = 1.0 if abs(normal_relative_angle(m[q + GAIM + NGUNS] - actual)) < width else 0.0
+                st[S_ASR] = (st[S_ASR] * 19 + hit) / 20
                 m[q + GON] = 0.0
     head = m[e + EB]
     linear = _predicted(m, t, x, y, bs, 0.0, w, h)
     circular = _predicted(m, t, x, y, bs, turn_rate, w, h)
-    best = MID
     base = S_GF + seg * BINS
-    for k in range(BINS):
-        if st[base + k] > st[base + best]:
-            best = k
+    best = _peak(st, base)
     guess = m[e + EB] + m[T_GUNDIR] * (best - MID) / float(MID) * mea
+    as_base = S_AS + seg // 27 * BINS
+    as_best = _peak(st, as_base)
+    as_guess = m[e + EB] + m[T_GUNDIR] * (as_best - MID) / float(MID) * mea
+    if gun_kind == G_AS and st[S_ASR] > st[S_VG + G_GF] + AS_MARGIN:  # the anti-surfer aim while it hits more
+        base = as_base
+        best = as_best
     total = 0.0
     for q in range(BINS):
         total += st[base + q]
@@ -482,12 +509,15 @@ def _aim_and_fire(m, st, cmd, gun_kind, move_kind, t, x, y, now, energy, gun_hea
     m[q + GAIM + 1] = linear
     m[q + GAIM + 2] = circular
     m[q + GAIM + 3] = guess
+    m[q + GAIM + NGUNS] = as_guess
     gun = gun_kind
     if gun == G_VIRTUAL:
         gun = G_CIRCULAR
         for gq in range(NGUNS):
             if st[S_VG + gq] > st[S_VG + gun]:
                 gun = gq
+    elif gun == G_AS:
+        gun = G_GF if base != as_base else NGUNS
     aim = m[q + GAIM + gun]
     if gun_heat == 0 and abs(gun_rem) < 0.05 and energy > power + 0.1:
         cmd[4] = power

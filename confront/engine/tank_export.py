@@ -292,6 +292,8 @@ class TankPolicy:
                  f"fire_powers {nums(s.fire_powers)}", f"enemy_slots {s.enemy_slots}",
                  f"mate_slots {s.mate_slots}", f"leads {' '.join(s.leads)}"]
         lines += [f"{name} 1" for name in ("surf", "knowledge") if getattr(s, name)]  # skills: absent when off
+        if s.skills and s.brain != "SurfGF":  # absent: SurfGF, the brain of older files
+            lines.append(f"brain {s.brain}")
         if self.play != "greedy":
             lines.append(f"play {self.play}")
         for f in fields(ControlConfig):

@@ -32,6 +32,7 @@ TECH_ROBOTS: dict[str, tuple[str, str]] = {
     "SurfCircular": ("circular", "wave surfing"),
     "SurfGF": ("GuessFactor", "wave surfing"),
     "SurfVG": ("virtual guns", "wave surfing"),
+    "SurfAS": ("GuessFactor and anti-surfer GuessFactor", "wave surfing"),
     "RiskGF": ("GuessFactor", "minimum risk"),
 }
 PACKAGE = "confront.tech"

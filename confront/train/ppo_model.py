@@ -29,7 +29,7 @@ def tank_space(cfg: ExperimentConfig) -> TankSpace:
     t = cfg.tank
     return TankSpace(distances=tuple(t.distances), turns_deg=tuple(t.turns_deg), turn_mode=t.turn_mode,
                      fire_powers=tuple(t.fire_powers), enemy_slots=t.enemy_slots, mate_slots=t.mate_slots,
-                     leads=tuple(t.leads), surf=t.surf, knowledge=t.knowledge)
+                     leads=tuple(t.leads), surf=t.surf, knowledge=t.knowledge, brain=t.brain)
 
 
 def skill_logits(space: TankSpace, prior: float) -> np.ndarray:

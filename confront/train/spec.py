@@ -23,7 +23,7 @@ SCRIPTED_BOTS = ("SittingDuck", "SpinBot", "Walls", "Tracker", "RamFire", "Fire"
 # the technique robots of confront.arena.tech.TECH_ROBOTS (Java twins confront.tech.*), known without loading the
 # simulator (a test keeps them equal)
 TECH_BOTS = ("RamHeadOn", "StopGoCircular", "OrbitLinear", "OrbitCircular", "OrbitVG", "OrbitGF", "SurfCircular",
-             "SurfGF", "SurfVG", "RiskGF")
+             "SurfGF", "SurfVG", "SurfAS", "RiskGF")
 RUN_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 
 
@@ -141,6 +141,9 @@ class TankSection:
                        "surfing (minimum risk in melee) for the step")
     knowledge: bool = field(False, doc="a skill: the view ends with 8 features of what the technique brain knows "
                             "about this battle (virtual-gun hit rates, enemy waves, how peaked its statistics are)")
+    brain: Literal["SurfGF", "SurfAS"] = field(
+        "SurfGF", doc="the technique robot the skills follow: SurfGF (wave surfing, GuessFactor gun) or SurfAS (the "
+        "same with an anti-surfer GuessFactor gun beside it: fading visit counts, aiming while they hit more)")
     skill_prior: float = field(0.0, ge=0.0, le=10.0, doc="the untrained policy's logit bonus for the skills' "
                                "choices (surf, the gf lead): at 3 it surfs and aims by GuessFactor 80% of the time "
                                "and learns when not to; 0: every choice alike")

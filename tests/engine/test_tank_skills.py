@@ -47,6 +47,9 @@ def test_policy_files_without_skills_are_as_before(tmp_path: Path) -> None:
         q = load_tank_policy(model.parent)
         assert q.space == space and q.to_text() == p.to_text()
     assert "surf 1\nknowledge 1\n" in _policy(2).to_text() and "leads none circular gf\n" in _policy(2).to_text()
+    assert "brain" not in _policy(2).to_text()  # SurfGF, the brain of older files
+    anti = TankSpace(leads=("gf",), knowledge=True, brain="SurfAS")
+    assert "knowledge 1\nbrain SurfAS\n" in _policy(2, anti).to_text()
 
 
 # fixed starts, or the engine's own from its seed (the simulator draws Robocode's random processing order only when
@@ -56,10 +59,11 @@ STARTS = {("1v1", "SpinBot"): ((150.0, 120.0, 30.0), (550.0, 420.0, 200.0))}
 
 
 @pytest.mark.engine
-@pytest.mark.parametrize(("scenario", "opponent"), [("1v1", "SpinBot"), ("1v1", "SurfVG"), ("4v4", "SpinBot")])
-def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, scenario, opponent) -> None:
+@pytest.mark.parametrize(("scenario", "opponent", "brain"), [("1v1", "SpinBot", "SurfGF"), ("1v1", "SurfVG", "SurfGF"),
+                                                         ("4v4", "SpinBot", "SurfGF"), ("1v1", "SurfVG", "SurfAS")])
+def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, scenario, opponent, brain) -> None:
     """Against SpinBot (a team of them in 4v4, where the brain moves by minimum risk) and the technique robot
-    SurfVG (a wave surfer with virtual guns, in both): every robot's pose and
+    SurfVG (a wave surfer with virtual guns, in both), with either brain: every robot's pose and
     energy agree at every turn while all live (1v1 from fixed starts: up to the first bullet-bullet hit, whose order
     is random there; docs/engine.md),
     and every decision's view and action (TankBot's decision log) equal the simulator's. The policy picks surf and
@@ -74,7 +78,8 @@ def test_skills_tank_plays_like_the_simulator_turn_by_turn(install, tmp_path, sc
     p = _policy(6 if scenario == "1v1" else 2)
     b2 = p.biases[-1].copy()
     b2[len(SKILLS.distances)] += 1.5  # surf more often
-    policy = TankPolicy(p.weights, (*p.biases[:-1], b2), SKILLS, p.control, p.step_turns)
+    policy = TankPolicy(p.weights, (*p.biases[:-1], b2), dataclasses.replace(SKILLS, brain=brain), p.control,
+                        p.step_turns)
     starts = STARTS.get((scenario, opponent))
     n_tanks = 1 if scenario == "1v1" else 4
     jar = export_tank_robot(policy, tmp_path / "tankbot.jar", install)

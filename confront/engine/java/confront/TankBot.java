@@ -37,7 +37,7 @@ import confront.tech.TechBrain;
  * is unknown or dead), with the step's lead (none, linear or circular).
  *
  * <p>With skills (TankModel: surf, the lead gf, knowledge) the tank carries a technique brain
- * (confront.tech.TechBrain, SurfGF's decisions; confront.arena.tank): every turn it is given the turn's events and
+ * (confront.tech.TechBrain, the decisions of SurfGF or SurfAS (TankModel.brain); confront.arena.tank): every turn it is given the turn's events and
  * decides (after the view of a decision turn is made, before any command is set); its commands are proposed, not
  * sent: the body follows its movement during a step whose distance is surf, the gun its GuessFactor aim at the
  * target with the lead gf, and its knowledge block ends the view. The tank's controller drives the radar.
@@ -99,7 +99,8 @@ public class TankBot extends TeamRobot {
         boolean surfing = false;
         if (model.skills()) {
             TechBrain.startBattle(getX(), getY());
-            brain();
+            int gun = "SurfAS".equals(model.brain) ? TechBrain.G_AS : TechBrain.G_GF;
+            brain = new TechBrain(gun, TechBrain.M_SURF, getBattleFieldWidth(), getBattleFieldHeight());
         }
         long next = 0;  // the next decision turn: 0, step, 2 step, ... (a skipped decision turn is made up at once)
         while (true) {
@@ -284,14 +285,6 @@ public class TankBot extends TeamRobot {
         } catch (IOException e) {
             out.println("CONFRONT tank-error broadcast " + e);
         }
-    }
-
-    /** The technique brain of this round (a tank with skills). */
-    private TechBrain brain() {
-        if (brain == null) {
-            brain = new TechBrain(TechBrain.G_GF, TechBrain.M_SURF, getBattleFieldWidth(), getBattleFieldHeight());
-        }
-        return brain;
     }
 
     @Override

@@ -12,7 +12,8 @@ import java.io.Reader;
  *
  * <p>Skills (opt-in keys, absent in older files: off): "surf 1" (the distance head's extra last entry: the body
  * follows the technique brain's movement), the lead "gf" (the brain's GuessFactor aim), "knowledge 1" (the brain's
- * knowledge block at the end of the view); see confront.arena.tank and TankBot.
+ * knowledge block at the end of the view), "brain SurfAS" (the brain's gun: GuessFactor beside anti-surfer GuessFactor;
+ * absent: SurfGF); see confront.arena.tank and TankBot.
  *
  * <p>Angles follow Robocode: radians, 0 = north (+y), clockwise. Enemy rows are {x, y, energy, heading,
  * velocity, energy drop, scan time, turn rate} of the last scan this round (turnRate: see turnRate()); mate rows
@@ -44,6 +45,7 @@ public final class TankModel {
     final boolean sampled;  // "play sampled": act draws each head from its softmax (sample), else greedy (act)
     final boolean surf;  // the distance head's extra last entry: the body follows the brain's movement
     final boolean knowledge;  // the view ends with the brain's knowledge block
+    final String brain;  // the technique robot the skills follow: SurfGF, or SurfAS (its gun beside an anti-surfer one)
 
     private TankModel(ModelFile f) throws IOException {
         distances = f.list("distances");
@@ -66,6 +68,7 @@ public final class TankModel {
         sampled = "sampled".equals(f.choice("play", "greedy", "greedy", "sampled"));
         surf = "1".equals(f.choice("surf", "0", "0", "1"));
         knowledge = "1".equals(f.choice("knowledge", "0", "0", "1"));
+        brain = f.choice("brain", "SurfGF", "SurfGF", "SurfAS");
         actor = f.mlp("tanh", "linear", 0.0, 0.0);
         f.allTaken();
         int heads = 0;

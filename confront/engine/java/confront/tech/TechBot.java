@@ -17,7 +17,7 @@ import robocode.TeamRobot;
  */
 public abstract class TechBot extends TeamRobot {
     static final int G_HEAD = TechBrain.G_HEAD, G_LINEAR = TechBrain.G_LINEAR, G_CIRCULAR = TechBrain.G_CIRCULAR,
-            G_GF = TechBrain.G_GF, G_VIRTUAL = TechBrain.G_VIRTUAL;
+            G_GF = TechBrain.G_GF, G_VIRTUAL = TechBrain.G_VIRTUAL, G_AS = TechBrain.G_AS;
     static final int M_ORBIT = TechBrain.M_ORBIT, M_STOPGO = TechBrain.M_STOPGO, M_RAM = TechBrain.M_RAM,
             M_SURF = TechBrain.M_SURF, M_RISK = TechBrain.M_RISK;
 

@@ -10,7 +10,9 @@ import robocode.util.Utils;
  * tank's skills (its GuessFactor aim, its surfing moves) and for what it knows about the battle (knowledge()).
  *
  * Guns: head-on, linear, circular, GuessFactor (visit counts per segment: distance, lateral velocity,
- * acceleration, distance to the wall ahead), virtual guns (the gun with the best rolling hit rate).
+ * acceleration, distance to the wall ahead), virtual guns (the gun with the best rolling hit rate), an
+ * anti-surfer GuessFactor gun (visit counts per distance segment that fade at each visit, AS_DECAY; it aims
+ * while its rolling hit rate beats the GuessFactor aim's by AS_MARGIN, else the GuessFactor aim does).
  * Movements: random orbit with wall smoothing, stop-and-go, ramming, wave surfing (waves from the enemy's
  * energy drops, precise prediction of our own path, danger from where its bullets hit us), minimum risk
  * (melee: used while more than one other robot is alive).
@@ -23,7 +25,7 @@ import robocode.util.Utils;
  * so it lives for the battle's rounds; a brain object lives for one round.
  */
 public final class TechBrain {
-    public static final int G_HEAD = 0, G_LINEAR = 1, G_CIRCULAR = 2, G_GF = 3, G_VIRTUAL = 4;
+    public static final int G_HEAD = 0, G_LINEAR = 1, G_CIRCULAR = 2, G_GF = 3, G_VIRTUAL = 4, G_AS = 5;
     public static final int M_ORBIT = 0, M_STOPGO = 1, M_RAM = 2, M_SURF = 3, M_RISK = 4;
     static final int BINS = 31, MID = 15;
     static final int SEGMENTS = 5 * 3 * 3 * 3;
@@ -34,12 +36,15 @@ public final class TechBrain {
     /** Length of knowledge(). */
     public static final int KNOWLEDGE = 8;
     static final double MAX_IMPACT = 50;  // turns: a wave further away (or none) reads as 1
+    static final double AS_DECAY = 0.7, AS_MARGIN = 0.03;
 
     // battle memory (one class load per battle)
     static Random rng;
     static double[] gf = new double[SEGMENTS * BINS];
     static double[] surf = new double[BINS];
     static double[] vgRate = new double[NGUNS];
+    static double[] asVisits = new double[5 * BINS];  // per distance segment, fading
+    static double asRate;  // the anti-surfer aim's rolling hit rate
 
     private final int gunKind, moveKind;
     private final double fieldWidth, fieldHeight;
@@ -75,7 +80,7 @@ public final class TechBrain {
     final double[] gx = new double[MAXG], gy = new double[MAXG], gt = new double[MAXG], gs = new double[MAXG],
             ga = new double[MAXG], gd = new double[MAXG], gm = new double[MAXG];
     final int[] gSeg = new int[MAXG], gTarget = new int[MAXG];
-    final double[] gAim = new double[MAXG * NGUNS];
+    final double[] gAim = new double[MAXG * NGUNS], gAsAim = new double[MAXG];
     final boolean[] gOn = new boolean[MAXG];
     int gNext;
     double moveDir = 1, gunDir = 1, destX = -1, destY = -1;
@@ -527,6 +532,17 @@ public final class TechBrain {
         return ((ds * 3 + ls) * 3 + as) * 3 + wsg;
     }
 
+    /** The fullest of the BINS counts from base (the first of equals; MID first). */
+    static int peak(double[] counts, int base) {
+        int best = MID;
+        for (int k = 0; k < BINS; k++) {
+            if (counts[base + k] > counts[base + best]) {
+                best = k;
+            }
+        }
+        return best;
+    }
+
     void aimAndFire(int t, double x, double y, long now) {
         double power = Math.min(3, 1.2 + 300 / ed[t]);
         if (moveKind == M_RAM && ed[t] < 150) {
@@ -564,11 +580,24 @@ public final class TechBrain {
                     if (c < BINS - 1) {
                         gf[base + c + 1] += 0.5;
                     }
+                    base = gSeg[k] / 27 * BINS;
+                    for (int j = 0; j < BINS; j++) {
+                        asVisits[base + j] *= AS_DECAY;
+                    }
+                    asVisits[base + c] += 1;
+                    if (c > 0) {
+                        asVisits[base + c - 1] += 0.5;
+                    }
+                    if (c < BINS - 1) {
+                        asVisits[base + c + 1] += 0.5;
+                    }
                     double width = Math.atan2(18, d);
                     for (int q = 0; q < NGUNS; q++) {
                         double hit = Math.abs(Utils.normalRelativeAngle(gAim[k * NGUNS + q] - actual)) < width ? 1 : 0;
                         vgRate[q] = (vgRate[q] * 19 + hit) / 20;
                     }
+                    double asHit = Math.abs(Utils.normalRelativeAngle(gAsAim[k] - actual)) < width ? 1 : 0;
+                    asRate = (asRate * 19 + asHit) / 20;
                     gOn[k] = false;
                 }
             }
@@ -577,21 +606,23 @@ public final class TechBrain {
         double head = eb[t];
         double linear = predicted(t, x, y, bs, 0);
         double circular = predicted(t, x, y, bs, turnRate);
-        int best = MID;
-        int base = seg * BINS;
-        for (int k = 0; k < BINS; k++) {
-            if (gf[base + k] > gf[base + best]) {
-                best = k;
-            }
-        }
+        int best = peak(gf, seg * BINS);
         double guess = eb[t] + gunDir * (best - MID) / (double) MID * mea;
+        int asBest = peak(asVisits, seg / 27 * BINS);
+        double asGuess = eb[t] + gunDir * (asBest - MID) / (double) MID * mea;
+        boolean antiSurf = gunKind == G_AS && asRate > vgRate[G_GF] + AS_MARGIN;
+        double[] counts = antiSurf ? asVisits : gf;
+        int base = antiSurf ? seg / 27 * BINS : seg * BINS;
+        if (antiSurf) {
+            best = asBest;
+        }
         double total = 0;
         for (int q = 0; q < BINS; q++) {
-            total += gf[base + q];
+            total += counts[base + q];
         }
         aimSlot = t;
         aimFactor = gunDir * (best - MID) / (double) MID;
-        aimPeak = total > 0 ? gf[base + best] / total : 0;
+        aimPeak = total > 0 ? counts[base + best] / total : 0;
         int k = gNext;
         gNext = (gNext + 1) % MAXG;
         gOn[k] = true;
@@ -608,6 +639,7 @@ public final class TechBrain {
         gAim[k * NGUNS + 1] = linear;
         gAim[k * NGUNS + 2] = circular;
         gAim[k * NGUNS + 3] = guess;
+        gAsAim[k] = asGuess;
         int gun = gunKind;
         if (gun == G_VIRTUAL) {
             gun = G_CIRCULAR;
@@ -616,8 +648,10 @@ public final class TechBrain {
                     gun = q;
                 }
             }
+        } else if (gun == G_AS) {
+            gun = G_GF;
         }
-        double aim = gAim[k * NGUNS + gun];
+        double aim = antiSurf ? asGuess : gAim[k * NGUNS + gun];
         if (gunHeat == 0 && Math.abs(gunTurnRemaining) < 0.05 && energy > power + 0.1) {
             cmd[4] = power;
         }

@@ -4,7 +4,7 @@
 either a *learning tank* (driven by the caller's actions: the paper's four macro moves, optionally x 3
 fire powers, each held for T turns; its gun and radar follow :mod:`confront.arena.control`'s fixed
 controller) or a *scripted bot* (:mod:`confront.arena.bots`, commands every turn) or a *technique robot*
-(:mod:`confront.arena.tech`: RamHeadOn, ..., SurfVG, RiskGF, a decision every turn). Team 0 is always
+(:mod:`confront.arena.tech`: RamHeadOn, ..., SurfAS, RiskGF, a decision every turn). Team 0 is always
 learning; the other teams follow ``opponents`` (``"td"`` = learning tanks whose actions the caller also
 supplies, e.g. a TD team; a bot name = that sample robot or technique robot).
 

@@ -63,7 +63,7 @@ class OpponentSection:
     """Who the learning team fights: the TD team (paper §6.3), scripted sample robots or technique robots."""
 
     kind: str = field("td", doc="'td' for a TD-trained team, a scripted sample robot (e.g. SpinBot), a sample team "
-                      "(MyFirstTeam) or a technique robot (RamHeadOn ... SurfVG, RiskGF)")
+                      "(MyFirstTeam) or a technique robot (RamHeadOn ... SurfAS, RiskGF)")
     model: str = field("", doc="saved TD-team model (.npz); empty = train one first and cache it")
     pretrain_rounds: int = field(300, ge=0, doc="rounds the TD team trains before the experiment")
     pretrain_against: str = field("SpinBot", doc="scripted or technique robot the TD team trains against")
@@ -168,7 +168,7 @@ class LeagueSection:
         ("1v1:SittingDuck", "1v1:SpinBot", "1v1:Walls", "1v1:Tracker", "1v1:RamFire", "1v1:Fire", "1v1:Corners",
          "1v1:Crazy", "1v1:dodge", "1v1:self", "4v4:SpinBot", "4v4:Walls", "4v4:Tracker", "4v4:RamFire",
          "4v4:Crazy", "4v4:td", "4v4:dodge", "4v4:self"),
-        doc="SCENARIO:OPPONENT entries: a scripted sample robot or a technique robot (RamHeadOn ... SurfVG, RiskGF; "
+        doc="SCENARIO:OPPONENT entries: a scripted sample robot or a technique robot (RamHeadOn ... SurfAS, RiskGF; "
         "a team of it), a sample team (MyFirstTeam: a leader and droids, in scenarios whose other teams have 2 or "
         "more robots), td, random, dodge, strafe, or self (snapshots)")
     battles: int = field(8, ge=1, le=4096, doc="battles per entry")

@@ -7,6 +7,7 @@ plays), ``tank.json`` (actions, view, controller) and ``ppo.npz`` (the whole lea
 from __future__ import annotations
 
 import json
+import math
 import zipfile
 from dataclasses import asdict
 from pathlib import Path
@@ -32,14 +33,21 @@ def tank_space(cfg: ExperimentConfig) -> TankSpace:
                      leads=tuple(t.leads), surf=t.surf, knowledge=t.knowledge, brain=t.brain)
 
 
+BRAIN_POWER = 2.0  # the brain's gun at 400 px: min(3, 1.2 + 300 / d) (tech.py, _aim_and_fire)
+
+
 def skill_logits(space: TankSpace, prior: float) -> np.ndarray:
     """(sum(dims),) initial logit bonus of the skills' choices (``tank.skill_prior``): ``prior`` on surf (the
-    distance head's last entry) and on the gf lead, 0 elsewhere (all 0 without those skills)."""
+    distance head's last entry), on the gf lead and, with the gf lead, on the fire power nearest the brain's
+    (BRAIN_POWER); 0 elsewhere (all 0 without those skills)."""
     out = np.zeros(sum(space.dims))
     if space.surf:
         out[len(space.distances)] = prior
     if "gf" in space.leads:
         out[sum(space.dims[:4]) + space.leads.index("gf")] = prior
+        fire = [abs(p - BRAIN_POWER) if p > 0 else math.inf for p in space.fire_powers]
+        if min(fire) < math.inf:
+            out[sum(space.dims[:2]) + int(np.argmin(fire))] = prior
     return out
 
 

@@ -270,7 +270,8 @@ def test_skill_prior_sets_the_untrained_policys_probabilities() -> None:
 
     space = TankSpace(leads=("none", "linear", "circular", "gf"), surf=True)
     logits = skill_logits(space, 3.0)
-    assert logits.tolist() == [0] * 5 + [3] + [0] * 16 + [3]  # surf ends the distance head, gf the lead head
+    # surf ends the distance head, power 2 (the brain's, at 400 px) is the fire head's third, gf ends the lead head
+    assert logits.tolist() == [0] * 5 + [3] + [0] * 5 + [0, 0, 3, 0] + [0] * 7 + [3]
     assert not skill_logits(TankSpace(), 3.0).any()  # no skill: no prior
     obs = np.random.default_rng(0).normal(size=(4096, space.n_features)).astype(np.float32)
     ppo = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=logits)
@@ -278,7 +279,8 @@ def test_skill_prior_sets_the_untrained_policys_probabilities() -> None:
     surf, gf = (heads[:, 0] == 5).mean(), (heads[:, 4] == 3).mean()
     want = math.exp(3) / (math.exp(3) + 5), math.exp(3) / (math.exp(3) + 3)  # 0.801, 0.870 (other logits ~0)
     assert abs(surf - want[0]) < 0.03 and abs(gf - want[1]) < 0.03
-    assert abs((heads[:, 2] == 0).mean() - 0.25) < 0.03  # the fire head untouched
+    assert abs((heads[:, 2] == 2).mean() - want[1]) < 0.03  # power 2 of four powers, as gf of four leads
+    assert abs((heads[:, 3] == 0).mean() - 0.25) < 0.03  # the target head untouched
     plain = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1)
     same = PPO(space.n_features, space.dims, PPOConfig(hidden=32), seed=1, init_logits=skill_logits(space, 0.0))
     for a, b in zip(plain.state_dict().values(), same.state_dict().values(), strict=True):

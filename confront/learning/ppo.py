@@ -372,6 +372,8 @@ class PPO:
                 v_clip = mb_old_v + (v - mb_old_v).clamp(-c.clip, c.clip)
                 vl = 0.5 * torch.max((v - mb_ret) ** 2, (v_clip - mb_ret) ** 2).mean()
                 loss = pg - ent_coef * entropy + c.vf_coef * vl
+                if self.updates < c.value_warmup_updates:  # the critic alone: the actor gets no gradient
+                    loss = c.vf_coef * vl
                 self.opt.zero_grad()
                 loss.backward()
                 nn.utils.clip_grad_norm_(self.net.parameters(), c.max_grad_norm)

@@ -32,6 +32,8 @@ class PPOConfig:
     ent_coef_end: float = field(0.01, ge=0.0, le=10.0, doc="entropy coefficient after ent_anneal_updates")
     ent_anneal_updates: int = field(0, ge=0, doc="updates over which ent_coef goes linearly to ent_coef_end (0: off)")
     vf_coef: float = field(0.5, ge=0.0, le=100.0)
+    value_warmup_updates: int = field(0, ge=0, doc="the first updates train the critic alone (the actor keeps its "
+                                      "initial policy, e.g. tank.skill_prior's, until the advantages mean something)")
     max_grad_norm: float = field(0.5, gt=0.0)
     reward_scale: float = field(0.01, gt=0.0, doc="score points -> reward units")
     team_critic: bool = field(True, doc="the critic also sees the mean view of the tank's team (MAPPO-style)")

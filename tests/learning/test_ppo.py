@@ -230,6 +230,22 @@ def test_polyak_average_of_the_actor_hand_computed() -> None:
         from_dict(PPOConfig, {"ema_decay": 1.0}, prefix="ppo")
 
 
+def test_value_warmup_trains_the_critic_alone() -> None:
+    """value_warmup_updates = 2: the first two updates leave the actor's bits alone and move the critic; the third
+    moves the actor."""
+    rng = np.random.default_rng(2)
+    ppo = PPO(2, (2, 3), PPOConfig(hidden=8, lr=1e-2, team_critic=False, value_warmup_updates=2), seed=1)
+    actor0 = ppo.actor_arrays()
+    critic0 = [p.detach().clone() for p in ppo.net.critic.parameters()]
+    for _ in range(2):
+        ppo.update(_bandit_rollout(ppo, rng))
+        for k, v in ppo.actor_arrays().items():
+            np.testing.assert_array_equal(v, actor0[k], err_msg=k)
+    assert any(not torch.equal(a, b) for a, b in zip(critic0, ppo.net.critic.parameters(), strict=True))
+    ppo.update(_bandit_rollout(ppo, rng))
+    assert not np.array_equal(ppo.actor_arrays()["w0"], actor0["w0"])
+
+
 def test_learning_rate_anneals_linearly_to_zero() -> None:
     from confront.learning.ppo import learning_rate
 

@@ -171,7 +171,8 @@ def test_tensorboard_after_a_resume_has_each_step_once(runs: Path, tmp_path: Pat
     assert got == sorted(set(got)) and got == steps(runs / "paper")
 
 
-def test_ctrl_c_saves_and_the_run_resumes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_ctrl_c_saves_and_the_run_resumes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                          request: pytest.FixtureRequest) -> None:
     """Friction: Ctrl-C kept nothing before the first checkpoint; now it saves after the step it is in."""
     from confront.train.paper_sim import SMDPTrainer
 
@@ -187,6 +188,9 @@ def test_ctrl_c_saves_and_the_run_resumes(tmp_path: Path, monkeypatch: pytest.Mo
         return out
 
     monkeypatch.setattr(SMDPTrainer, "advance", then_ctrl_c)
+    # Python's own handler, also when the suite runs as a background job (which starts with SIGINT ignored)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    request.addfinalizer(lambda: signal.signal(signal.SIGINT, before))
     cfg = load_experiment("demo", [*PAPER[:2], "train.checkpoint_every=1000", *PAPER[3:]])
     with pytest.raises(Interrupted) as stop:
         train_run(cfg, tmp_path / "run", progress=False)

@@ -3,11 +3,14 @@
 
 from __future__ import annotations
 
+from typing import get_args, get_type_hints
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from confront.arena import tech
+from confront.arena.tank import BRAINS
 from confront.cli.main import cli
 from confront.config import ConfigError
 from confront.engine import battle, tech_robots
@@ -21,6 +24,8 @@ from confront.train.spec import load_experiment
 def test_the_technique_robot_names_agree_everywhere() -> None:
     assert spec.TECH_BOTS == tuple(tech.TECH_ROBOTS) == tuple(tech_robots.TECH_ROBOTS)
     assert battle.robot_class("SurfGF") == "confront.tech.SurfGF 1.0"  # the engine's class of the simulator's twin
+    brains = get_args(get_type_hints(spec.TankSection)["brain"])
+    assert brains == BRAINS and set(BRAINS) <= set(tech.TECH_ROBOTS)  # the config's brains are the tank's
 
 
 def test_paper_trainer_against_surfgf_teams() -> None:
